@@ -1,0 +1,25 @@
+# Project-wide compile settings applied through one interface target.
+add_library(bw_build_options INTERFACE)
+target_compile_options(bw_build_options INTERFACE
+  -Wall -Wextra
+  # note: no fused multiply-add, so results match across builds and machines.
+  -ffp-contract=off)
+if(BW_SANITIZE STREQUAL "address")
+  target_compile_options(bw_build_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(bw_build_options INTERFACE -fsanitize=address,undefined)
+elseif(BW_SANITIZE STREQUAL "thread")
+  target_compile_options(bw_build_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(bw_build_options INTERFACE -fsanitize=thread)
+elseif(NOT BW_SANITIZE STREQUAL "")
+  message(FATAL_ERROR "BW_SANITIZE must be empty, address or thread (got '${BW_SANITIZE}')")
+endif()
+add_library(bw::build_options ALIAS bw_build_options)
+
+# bw_add_module(NAME SOURCES... DEPS ...): one static library target bw::NAME per module.
+function(bw_add_module name)
+  cmake_parse_arguments(M "" "" "SOURCES;DEPS" ${ARGN})
+  add_library(bw_${name} STATIC ${M_SOURCES})
+  add_library(bw::${name} ALIAS bw_${name})
+  target_include_directories(bw_${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(bw_${name} PUBLIC bw::build_options ${M_DEPS})
+endfunction()

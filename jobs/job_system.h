@@ -1,0 +1,48 @@
+#pragma once
+/// Explicit thread-count control over oneTBB and deterministic parallel helpers.
+///
+///   bw::JobSystem jobs(4);                       // 4 worker threads (1 = serial)
+///   jobs.parallelFor(0, n, 256, [&](uint32_t begin, uint32_t end) { ... });
+///
+/// Determinism contract: parallelFor splits [begin, end) into chunks that depend only on the
+/// range and the grain (never on the thread count or on timing), so a stage that writes one
+/// output slot per item, or one partial result per chunk merged in chunk order, gives
+/// bit-identical results for any thread count.
+/// Thread safety: a JobSystem may be used from one controlling thread at a time.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace bw {
+
+class JobSystem {
+ public:
+  /// threads >= 1; throws InvalidInput otherwise. More threads than cores is allowed.
+  explicit JobSystem(int threads);
+  ~JobSystem();
+  JobSystem(const JobSystem&) = delete;
+  JobSystem& operator=(const JobSystem&) = delete;
+
+  int threadCount() const { return threads_; }
+
+  /// Runs body(chunkBegin, chunkEnd) over [begin, end) in chunks of at most `grain` items,
+  /// chunk boundaries at begin + k * grain. Returns when all chunks are done.
+  void parallelFor(uint32_t begin, uint32_t end, uint32_t grain,
+                   const std::function<void(uint32_t, uint32_t)>& body);
+
+  /// Number of chunks parallelFor uses for a range: callers size per-chunk outputs with it.
+  static uint32_t chunkCount(uint32_t begin, uint32_t end, uint32_t grain) {
+    return end > begin ? (end - begin + grain - 1) / grain : 0;
+  }
+
+  /// Runs f inside this system's arena (so nested TBB algorithms use its thread count).
+  void run(const std::function<void()>& f);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int threads_;
+};
+
+}  // namespace bw
