@@ -1,6 +1,7 @@
 #include "jobs/job_system.h"
 
 #include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
@@ -12,7 +13,11 @@
 namespace bw {
 
 struct JobSystem::Impl {
-  explicit Impl(int threads) : arena(threads) {}
+  // note: global_control lifts TBB's default cap (the core count) so a 16-thread run on a
+  // 2-core machine really has 16 threads, which the determinism tests rely on.
+  explicit Impl(int threads)
+      : control(tbb::global_control::max_allowed_parallelism, size_t(threads)), arena(threads) {}
+  tbb::global_control control;
   tbb::task_arena arena;
 };
 

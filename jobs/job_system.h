@@ -8,7 +8,9 @@
 /// range and the grain (never on the thread count or on timing), so a stage that writes one
 /// output slot per item, or one partial result per chunk merged in chunk order, gives
 /// bit-identical results for any thread count.
-/// Thread safety: a JobSystem may be used from one controlling thread at a time.
+/// Thread safety: a JobSystem may be used from one controlling thread at a time. It sets
+/// oneTBB's process-wide parallelism limit while it lives, so keep one JobSystem per process
+/// (or nest only equal thread counts): TBB applies the smallest limit of all live ones.
 #include <cstdint>
 #include <functional>
 #include <memory>

@@ -1,0 +1,323 @@
+#pragma once
+// Query templates of OctoBvh (included by octobvh.h). Kept as templates so callbacks and exact
+// hooks inline into the traversal loops.
+#include <algorithm>
+#include <bit>
+
+namespace bw {
+
+namespace octobvh_detail {
+/// Depth-first stack bound: <= 7 pending siblings per level over kMaxLevel - kMinLevel + 2 levels.
+constexpr int kStackSize = 7 * (octobvh::kMaxLevel - octobvh::kMinLevel + 2) + 16;
+struct RayEntry {
+  uint32_t node;  // cluster << 3 | slot
+  float t;        // entry parameter of the node's tight bounds
+};
+}  // namespace octobvh_detail
+
+template <class F>
+void OctoBvh::forEachHeld(const NodeCluster& cl, int s, F&& f) const {
+  using namespace octobvh;
+  if (cl.numHeld[s] == kOverflow) {
+    uint32_t left = overflow_[cl.leaf[s]].count;
+    for (uint32_t b = cl.leaf[s]; b != kNone && left; b = overflow_[b].next)
+      for (uint32_t i = 0; i < 14 && left; ++i, --left) f(overflow_[b].elements[i]);
+  } else if (cl.numHeld[s]) {
+    const LeafBlock& lb = leaves_[cl.leaf[s]];
+    for (int i = 0; i < cl.numHeld[s]; ++i) f(lb.elements[i]);
+  }
+}
+
+namespace octobvh_detail {
+/// Bit o set when node o of the cluster matches the mask and its tight bounds overlap box.
+/// note: written as a branch-free loop over the SoA arrays so the compiler vectorises it.
+inline unsigned overlapMask(const octobvh::NodeCluster& ch, const Aabb& box, uint32_t mask, unsigned& candidates) {
+  unsigned hits = 0, cand = 0;
+  for (int o = 0; o < 8; ++o) {
+    const bool match = (ch.filter[o] & mask) != 0;
+    const bool ov = (ch.minX[o] <= box.max.x()) & (ch.maxX[o] >= box.min.x()) & (ch.minY[o] <= box.max.y()) &
+                    (ch.maxY[o] >= box.min.y()) & (ch.minZ[o] <= box.max.z()) & (ch.maxZ[o] >= box.min.z());
+    cand |= unsigned(match) << o;
+    hits |= unsigned(match & ov) << o;
+  }
+  candidates = cand;
+  return hits;
+}
+
+inline bool elementOverlaps(const octobvh::ElementRecord& r, const Aabb& b) {
+  return r.min[0] <= b.max.x() && r.max[0] >= b.min.x() && r.min[1] <= b.max.y() && r.max[1] >= b.min.y() &&
+         r.min[2] <= b.max.z() && r.max[2] >= b.min.z();
+}
+}  // namespace octobvh_detail
+
+template <class F, class Exact>
+void OctoBvh::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
+  using namespace octobvh;
+  using namespace octobvh_detail;
+  const NodeCluster& root = clusters_[rootCluster_];
+  uint64_t tests = 0, elementTests = 0;
+  if (root.filter[0] & mask) {
+    ++tests;
+    uint32_t stack[kStackSize];
+    int sp = 0;
+    if (root.bounds(0).overlaps(box)) stack[sp++] = nodeRef(rootCluster_, 0);
+    while (sp) {
+      const uint32_t ref = stack[--sp];
+      const NodeCluster& cl = clusters_[ref >> 3];
+      const int s = int(ref & 7);
+      forEachHeld(cl, s, [&](uint32_t e) {
+        const ElementRecord& r = elements_[e];
+        if (!(r.filter & mask)) return;
+        ++tests;
+        ++elementTests;
+        if (elementOverlaps(r, box) && exact(e, r.bounds())) f(e);
+      });
+      if (cl.child[s] == kNone) continue;
+      unsigned candidates;
+      unsigned hits = overlapMask(clusters_[cl.child[s]], box, mask, candidates);
+      tests += unsigned(std::popcount(candidates));
+      while (hits) {
+        const int o = std::countr_zero(hits);
+        hits &= hits - 1;
+        stack[sp++] = nodeRef(cl.child[s], o);
+      }
+    }
+  }
+  if (stats) {
+    stats->boxTests += tests;
+    stats->elementTests += elementTests;
+  }
+}
+
+template <class F, class Exact>
+void OctoBvh::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
+  using namespace octobvh;
+  using namespace octobvh_detail;
+  const Aabb outer = box.bounds();
+  const NodeCluster& root = clusters_[rootCluster_];
+  uint64_t tests = 0, elementTests = 0;
+  // note: the cheap AABB-of-the-OBB test rejects most nodes before the 15-axis SAT runs.
+  auto hit = [&](const Aabb& b) { return b.overlaps(outer) && bw::overlaps(box, b); };
+  if (root.filter[0] & mask) {
+    ++tests;
+    uint32_t stack[kStackSize];
+    int sp = 0;
+    if (hit(root.bounds(0))) stack[sp++] = nodeRef(rootCluster_, 0);
+    while (sp) {
+      const uint32_t ref = stack[--sp];
+      const NodeCluster& cl = clusters_[ref >> 3];
+      const int s = int(ref & 7);
+      forEachHeld(cl, s, [&](uint32_t e) {
+        const ElementRecord& r = elements_[e];
+        if (!(r.filter & mask)) return;
+        ++tests;
+        ++elementTests;
+        const Aabb eb = r.bounds();
+        if (hit(eb) && exact(e, eb)) f(e);
+      });
+      if (cl.child[s] == kNone) continue;
+      unsigned candidates;
+      unsigned near = overlapMask(clusters_[cl.child[s]], outer, mask, candidates);
+      tests += unsigned(std::popcount(candidates));
+      const NodeCluster& ch = clusters_[cl.child[s]];
+      while (near) {
+        const int o = std::countr_zero(near);
+        near &= near - 1;
+        if (bw::overlaps(box, ch.bounds(o))) stack[sp++] = nodeRef(cl.child[s], o);
+      }
+    }
+  }
+  if (stats) {
+    stats->boxTests += tests;
+    stats->elementTests += elementTests;
+  }
+}
+
+template <class F, class L>
+void OctoBvh::overlapLod(const Aabb& box, uint32_t mask, float lodFraction, F&& onElement, L&& onLod,
+                         QueryStats* stats) const {
+  using namespace octobvh;
+  using namespace octobvh_detail;
+  const float threshold = lodFraction * box.extent().maxCoeff();
+  const NodeCluster& root = clusters_[rootCluster_];
+  uint64_t tests = 0, elementTests = 0;
+  auto subtreeCount = [&](uint32_t c, int s) {
+    const NodeCluster& cl = clusters_[c];
+    return heldCount(c, s) + (cl.child[s] != kNone ? clusters_[cl.child[s]].childTotal : 0u);
+  };
+  // A subtree is "small" when its tight bounds' largest extent is below the threshold.
+  auto small = [&](const NodeCluster& cl, int o) {
+    return cl.maxX[o] - cl.minX[o] < threshold && cl.maxY[o] - cl.minY[o] < threshold && cl.maxZ[o] - cl.minZ[o] < threshold;
+  };
+  if (root.filter[0] & mask) {
+    ++tests;
+    uint32_t stack[kStackSize];
+    int sp = 0;
+    if (root.bounds(0).overlaps(box)) {
+      if (small(root, 0)) onLod(LodBox{root.bounds(0), root.filter[0], subtreeCount(rootCluster_, 0)});
+      else stack[sp++] = nodeRef(rootCluster_, 0);
+    }
+    while (sp) {
+      const uint32_t ref = stack[--sp];
+      const NodeCluster& cl = clusters_[ref >> 3];
+      const int s = int(ref & 7);
+      forEachHeld(cl, s, [&](uint32_t e) {
+        const ElementRecord& r = elements_[e];
+        if (!(r.filter & mask)) return;
+        ++tests;
+        ++elementTests;
+        if (elementOverlaps(r, box)) onElement(e);
+      });
+      if (cl.child[s] == kNone) continue;
+      const uint32_t c = cl.child[s];
+      const NodeCluster& ch = clusters_[c];
+      unsigned candidates;
+      unsigned hits = overlapMask(ch, box, mask, candidates);
+      tests += unsigned(std::popcount(candidates));
+      while (hits) {
+        const int o = std::countr_zero(hits);
+        hits &= hits - 1;
+        if (small(ch, o)) onLod(LodBox{ch.bounds(o), ch.filter[o], subtreeCount(c, o)});
+        else stack[sp++] = nodeRef(c, o);
+      }
+    }
+  }
+  if (stats) {
+    stats->boxTests += tests;
+    stats->elementTests += elementTests;
+  }
+}
+
+inline std::array<uint8_t, 8> OctoBvh::rayChildOrder(const Vec3f& dir) {
+  // Axes by decreasing |dir|: the major axis gets the most significant bit of the visit counter,
+  // so all four children on the near side of the major split come first. Each bit is flipped
+  // for axes the ray travels down (negative component), making "near" bit value 0.
+  int axis[3] = {0, 1, 2};
+  const float mag[3] = {std::abs(dir.x()), std::abs(dir.y()), std::abs(dir.z())};
+  std::stable_sort(axis, axis + 3, [&](int a, int b) { return mag[a] > mag[b]; });
+  std::array<uint8_t, 8> order{};
+  for (int k = 0; k < 8; ++k) {
+    int slot = 0;
+    for (int rank = 0; rank < 3; ++rank) {
+      const int a = axis[rank];
+      const int bit = ((k >> (2 - rank)) & 1) ^ (dir[a] < 0.f ? 1 : 0);
+      slot |= bit << a;
+    }
+    order[k] = uint8_t(slot);
+  }
+  return order;
+}
+
+namespace octobvh_detail {
+/// Shared ray traversal: calls onElement(e, tEnterBox) for elements whose bounds the ray enters
+/// before the current limit; onElement returns the new limit (pruning farther nodes) and may
+/// set `stop` to end the traversal.
+template <class Tree, class OnElement>
+void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::array<uint8_t, 8>& order, float& limit,
+                 bool& stop, uint64_t& tests, uint64_t& elementTests, OnElement&& onElement) {
+  using namespace octobvh;
+  const uint32_t rootC = tree.rootCluster();
+  const NodeCluster& root = tree.cluster(rootC);
+  if (!(root.filter[0] & mask)) return;
+  ++tests;
+  float t;
+  if (!intersectRayAabb(ray, root.bounds(0), 0.f, limit, t)) return;
+  RayEntry stack[kStackSize];
+  int sp = 0;
+  stack[sp++] = {nodeRef(rootC, 0), t};
+  while (sp && !stop) {
+    const RayEntry top = stack[--sp];
+    if (top.t > limit) continue;  // a closer hit was found after this node was pushed
+    const NodeCluster& cl = tree.cluster(top.node >> 3);
+    const int s = int(top.node & 7);
+    tree.forEachHeldPublic(cl, s, [&](uint32_t e) {
+      if (stop) return;
+      const ElementRecord& r = tree.element(e);
+      if (!(r.filter & mask)) return;
+      ++tests;
+      ++elementTests;
+      float te;
+      if (intersectRayAabb(ray, r.bounds(), 0.f, limit, te)) limit = onElement(e, te, stop);
+    });
+    if (cl.child[s] == kNone) continue;
+    const uint32_t c = cl.child[s];
+    const NodeCluster& ch = tree.cluster(c);
+    // Push far-to-near so the nearest child is popped first.
+    for (int k = 7; k >= 0; --k) {
+      const int o = order[k];
+      if (!(ch.filter[o] & mask)) continue;
+      ++tests;
+      float tc;
+      if (intersectRayAabb(ray, ch.bounds(o), 0.f, limit, tc)) stack[sp++] = {nodeRef(c, o), tc};
+    }
+  }
+}
+}  // namespace octobvh_detail
+
+template <class Exact>
+RayHit OctoBvh::raycastClosest(const Ray& ray, uint32_t mask, QueryStats* stats, Exact&& exact,
+                               RayChildOrder orderKind) const {
+  std::array<uint8_t, 8> order = rayChildOrder(ray.dir);
+  if (orderKind == RayChildOrder::Reversed) std::reverse(order.begin(), order.end());
+  RayHit best{RayHit().element, ray.maxT};
+  float limit = ray.maxT;
+  bool stop = false;
+  uint64_t tests = 0, elementTests = 0;
+  octobvh_detail::traverseRay(*this, ray, mask, order, limit, stop, tests, elementTests,
+                              [&](uint32_t e, float tBox, bool&) {
+                                float th;
+                                if (exact(e, tBox, limit, th) && th <= limit &&
+                                    (th < best.t || (th == best.t && e < best.element)))
+                                  best = {e, th};
+                                return best.hit() ? best.t : limit;
+                              });
+  if (stats) {
+    stats->boxTests += tests;
+    stats->elementTests += elementTests;
+  }
+  return best;
+}
+
+template <class Exact>
+RayHit OctoBvh::raycastAny(const Ray& ray, uint32_t mask, QueryStats* stats, Exact&& exact) const {
+  RayHit found;
+  float limit = ray.maxT;
+  bool stop = false;
+  uint64_t tests = 0, elementTests = 0;
+  octobvh_detail::traverseRay(*this, ray, mask, rayChildOrder(ray.dir), limit, stop, tests, elementTests,
+                              [&](uint32_t e, float tBox, bool& halt) {
+                                float th;
+                                if (exact(e, tBox, limit, th) && th <= limit) {
+                                  found = {e, th};
+                                  halt = true;
+                                }
+                                return limit;
+                              });
+  if (stats) {
+    stats->boxTests += tests;
+    stats->elementTests += elementTests;
+  }
+  return found;
+}
+
+template <class Exact>
+void OctoBvh::raycastAll(const Ray& ray, uint32_t mask, std::vector<RayHit>& out, QueryStats* stats,
+                         Exact&& exact) const {
+  const size_t first = out.size();
+  float limit = ray.maxT;
+  bool stop = false;
+  uint64_t tests = 0, elementTests = 0;
+  octobvh_detail::traverseRay(*this, ray, mask, rayChildOrder(ray.dir), limit, stop, tests, elementTests,
+                              [&](uint32_t e, float tBox, bool&) {
+                                float th;
+                                if (exact(e, tBox, limit, th) && th <= limit) out.push_back({e, th});
+                                return limit;
+                              });
+  std::sort(out.begin() + first, out.end());
+  if (stats) {
+    stats->boxTests += tests;
+    stats->elementTests += elementTests;
+  }
+}
+
+}  // namespace bw
