@@ -3,9 +3,11 @@
 /// the size mix and clustering of real brick builds (article 000's load workload).
 ///
 /// Mix: ~90% small bricks (0.2..2 per side, microbricks down to 0.04 when enabled), ~9% medium
-/// (2..20), ~1% huge thin plates and ramps (one or two sides up to 500, thickness 0.04..2).
-/// Placement: `clusters` centres with uneven weights and radii (detailed spots next to sparse
-/// ones), positions snapped to a 0.2 lattice so many bricks touch exactly, as in a real build.
+/// (2..20), ~1% huge thin plates, walls and ramps (one side 50..500, another 2..50, thickness
+/// 0.04..2).
+/// Placement: `clusters` centres with very uneven brick counts; each cluster's radius is the one
+/// at which its bricks fill 10..60% of its volume (real bricks tile space rather than pile up),
+/// positions snapped to a 0.2 lattice so many bricks touch exactly, as in a real build.
 #include <cstdint>
 #include <vector>
 

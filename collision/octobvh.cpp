@@ -125,7 +125,15 @@ uint32_t OctoBvh::heldCount(uint32_t c, int s) const {
 void OctoBvh::heldAdd(uint32_t c, int s, uint32_t e) {
   NodeCluster& cl = clusters_[c];
   if (cl.numHeld[s] == 0) {
+    // note: a single held element is stored in the leaf field itself, no block.
+    cl.leaf[s] = e;
+    cl.numHeld[s] = 1;
+    return;
+  }
+  if (cl.numHeld[s] == 1) {
+    const uint32_t only = cl.leaf[s];
     cl.leaf[s] = leaves_.allocate();
+    leaves_[cl.leaf[s]].elements[0] = only;
   } else if (cl.numHeld[s] == kLeafCapacity) {
     // Only a min-level leaf holds more than 8: convert to an overflow chain.
     const uint32_t ob = overflow_.allocate();
@@ -192,13 +200,20 @@ void OctoBvh::heldRemove(uint32_t c, int s, uint32_t e) {
     }
     return;
   }
+  if (cl.numHeld[s] == 1) {
+    if (cl.leaf[s] != e) throw std::logic_error("OctoBvh: element missing from the node that must hold it");
+    cl.leaf[s] = kNone;
+    cl.numHeld[s] = 0;
+    return;
+  }
   LeafBlock& lb = leaves_[cl.leaf[s]];
   for (int i = 0; i < cl.numHeld[s]; ++i) {
     if (lb.elements[i] == e) {
       lb.elements[i] = lb.elements[--cl.numHeld[s]];
-      if (cl.numHeld[s] == 0) {
+      if (cl.numHeld[s] == 1) {  // back to an inline single element
+        const uint32_t only = lb.elements[0];
         leaves_.free(cl.leaf[s]);
-        cl.leaf[s] = kNone;
+        cl.leaf[s] = only;
       }
       return;
     }
@@ -215,7 +230,7 @@ void OctoBvh::heldTake(uint32_t c, int s, std::vector<uint32_t>& out) {
       overflow_.free(b);
       b = next;
     }
-  } else if (cl.numHeld[s]) {
+  } else if (cl.numHeld[s] > 1) {
     leaves_.free(cl.leaf[s]);
   }
   cl.numHeld[s] = 0;

@@ -21,7 +21,8 @@ struct alignas(64) NodeCluster {
   float minX[8], minY[8], minZ[8];  // 96   tight bounds of each node's subtree (inverted when empty)
   float maxX[8], maxY[8], maxZ[8];  // 192
   uint32_t child[8];                // 224  cluster holding the node's 8 children, or kNone (leaf/empty)
-  uint32_t leaf[8];                 // 256  leaf block of elements held at the node, or kNone
+  uint32_t leaf[8];                 // 256  elements held at the node: the element itself when one,
+                                    //      a LeafBlock (2..8), an OverflowBlock chain, or kNone
   uint32_t filter[8];               // 288  OR of filter bits of every element in the subtree
   uint8_t numHeld[8];               // 296  elements held at the node; kOverflow: overflow chain
   int8_t maxMinLevel[8];            // 304  largest min level in the subtree (finds forced elements)

@@ -22,6 +22,8 @@ void OctoBvh::forEachHeld(const NodeCluster& cl, int s, F&& f) const {
     uint32_t left = overflow_[cl.leaf[s]].count;
     for (uint32_t b = cl.leaf[s]; b != kNone && left; b = overflow_[b].next)
       for (uint32_t i = 0; i < 14 && left; ++i, --left) f(overflow_[b].elements[i]);
+  } else if (cl.numHeld[s] == 1) {
+    f(cl.leaf[s]);  // a single element is stored inline
   } else if (cl.numHeld[s]) {
     const LeafBlock& lb = leaves_[cl.leaf[s]];
     for (int i = 0; i < cl.numHeld[s]; ++i) f(lb.elements[i]);

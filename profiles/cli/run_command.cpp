@@ -1,6 +1,9 @@
 // `brickworld run [WORKLOAD]`: the default headless stress run.
 // Until the world and its scene files exist (issue 7), the workloads are the engine's
-// building blocks under stress: `pool` grows a VirtualPool and frees it in random order.
+// building blocks under stress:
+//   octobvh (default): load a seeded brick build into the OctoBVH with the article's load
+//     workload (insert each brick, query around it), then overlaps, rays, edits and memory.
+//   pool: grow a VirtualPool to N elements and free 99% of it in random order.
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -8,6 +11,9 @@
 #include <random>
 
 #include "cli/command_registry.h"
+#include "collision/brick_workload.h"
+#include "collision/octobvh.h"
+#include "collision/seeded_random.h"
 #include "collision/virtual_pool.h"
 
 namespace bw::cli {
@@ -59,16 +65,112 @@ int runPoolStress(uint32_t elements, uint64_t seed, bool json) {
   return 0;
 }
 
-CommandRegistration reg{"run", "Headless stress run of a workload (default: pool)", [](CLI::App& cmd) {
-  auto workload = std::make_shared<std::string>("pool");
-  auto elements = std::make_shared<uint32_t>(10'000'000);
+double msSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+int runOctoBvhStress(uint32_t elements, uint64_t seed, bool json) {
+  using Clock = std::chrono::steady_clock;
+  BrickWorkloadParams p;
+  p.count = elements;
+  p.seed = seed;
+  p.extent = elements >= 1'000'000 ? 4000.f : 2000.f;
+  const std::vector<Aabb> bricks = generateBrickWorkload(p);
+  OctoBvh tree(OctoBvh::Config{elements + 1024});
+
+  QueryStats loadStats;
+  uint64_t neighbours = 0;
+  auto t = Clock::now();
+  for (uint32_t i = 0; i < elements; ++i) {
+    tree.insert(bricks[i], 1, i);
+    tree.overlap(bricks[i].expanded(0.05f), 1, [&](uint32_t) { ++neighbours; }, &loadStats);
+  }
+  const double loadMs = msSince(t);
+
+  constexpr uint32_t kQueries = 20'000;
+  SeededRandom r(seed + 1);
+  QueryStats overlapStats, rayStats;
+  uint64_t overlapHits = 0, rayHits = 0;
+  t = Clock::now();
+  for (uint32_t q = 0; q < kQueries; ++q) {
+    const Vec3f c = bricks[r.below(elements)].center();
+    tree.overlap(Aabb::fromCenterHalf(c, Vec3f::Constant(1.f)), 1, [&](uint32_t) { ++overlapHits; }, &overlapStats);
+  }
+  const double overlapMs = msSince(t);
+  t = Clock::now();
+  for (uint32_t q = 0; q < kQueries; ++q) {
+    const Vec3f dir = Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized();
+    const Vec3f o = bricks[r.below(elements)].center() + dir * 3.f;
+    rayHits += tree.raycastClosest(Ray::make(o, dir, 200.f), 1, &rayStats).hit();
+  }
+  const double rayMs = msSince(t);
+
+  // Edits: move 1% of the bricks and put them back (a player rebuilding), no rebuild of the index.
+  const uint32_t edits = std::max<uint32_t>(elements / 100, 1);
+  std::vector<uint32_t> moved;
+  t = Clock::now();
+  for (uint32_t k = 0; k < edits; ++k) {
+    const uint32_t h = r.below(elements);
+    const Aabb& b = bricks[tree.payload(h)];
+    tree.update(h, {b.min + Vec3f(0, 0.4f, 0), b.max + Vec3f(0, 0.4f, 0)}, 1);
+    moved.push_back(h);
+  }
+  for (uint32_t h : moved) tree.update(h, bricks[tree.payload(h)], 1);
+  const double editMs = msSince(t);
+  const auto mem = tree.memoryStats();
+  const auto shape = tree.shapeStats();
+
+  if (json) {
+    nlohmann::json j{{"workload", "octobvh"},
+                     {"elements", elements},
+                     {"seed", seed},
+                     {"load_ms", loadMs},
+                     {"load_box_tests", loadStats.boxTests},
+                     {"overlap_2m_us", overlapMs * 1e3 / kQueries},
+                     {"overlap_box_tests", double(overlapStats.boxTests) / kQueries},
+                     {"ray_200m_us", rayMs * 1e3 / kQueries},
+                     {"ray_box_tests", double(rayStats.boxTests) / kQueries},
+                     {"ray_hit_rate", double(rayHits) / kQueries},
+                     {"update_us", editMs * 1e3 / (2.0 * edits)},
+                     {"bytes_per_element", double(mem.totalBytes()) / elements},
+                     {"resident_bytes", tree.residentBytes()},
+                     {"depth", shape.depth},
+                     {"forced_nodes", shape.forcedNodes},
+                     {"structure_hash", tree.structureHash()}};
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::printf("octobvh stress: %u bricks (seeded build, seed %llu)\n", elements, (unsigned long long)seed);
+    std::printf("  load (insert + query around each)  %9.1f ms  %6.2f us/brick  %.3g box tests (%.0f per brick)\n", loadMs,
+                loadMs * 1e3 / elements, double(loadStats.boxTests), double(loadStats.boxTests) / elements);
+    std::printf("  2 m overlap                        %9.2f us/query  %.0f box tests, %.1f hits\n", overlapMs * 1e3 / kQueries,
+                double(overlapStats.boxTests) / kQueries, double(overlapHits) / kQueries);
+    std::printf("  200 m closest-hit ray              %9.2f us/ray    %.0f box tests, %.0f%% hit\n", rayMs * 1e3 / kQueries,
+                double(rayStats.boxTests) / kQueries, 100.0 * rayHits / kQueries);
+    std::printf("  update (move brick)                %9.2f us/op\n", editMs * 1e3 / (2.0 * edits));
+    std::printf("  memory                             %9.1f B/element (%.1f nodes, %.1f leaves, %.1f elements), %.1f MiB resident\n",
+                double(mem.totalBytes()) / elements, double(mem.nodeBytes) / elements, double(mem.leafBytes) / elements,
+                double(mem.elementBytes) / elements, tree.residentBytes() / 1048576.0);
+    std::printf("  shape                              depth %d, %llu leaves, %llu inner nodes, %llu forced splits\n", shape.depth,
+                (unsigned long long)shape.leaves, (unsigned long long)shape.innerNodes, (unsigned long long)shape.forcedNodes);
+    std::printf("  structure hash                     %016llx\n", (unsigned long long)tree.structureHash());
+  }
+  return 0;
+}
+
+CommandRegistration reg{"run", "Headless stress run of a workload (default: octobvh)", [](CLI::App& cmd) {
+  auto workload = std::make_shared<std::string>("octobvh");
+  auto elements = std::make_shared<uint32_t>(0);
   auto seed = std::make_shared<uint64_t>(1);
   auto json = std::make_shared<bool>(false);
-  cmd.add_option("workload", *workload, "pool")->check(CLI::IsMember({"pool"}));
-  cmd.add_option("--elements", *elements, "element count")->check(CLI::Range(1u, 1'000'000'000u));
+  cmd.add_option("workload", *workload, "octobvh (default) or pool")->check(CLI::IsMember({"octobvh", "pool"}));
+  cmd.add_option("--elements", *elements, "element count (default 1M bricks / 10M pool slots)")
+      ->check(CLI::Range(1u, 1'000'000'000u));
   cmd.add_option("--seed", *seed, "random seed");
   cmd.add_flag("--json", *json, "print one JSON object");
-  return [=] { return runPoolStress(*elements, *seed, *json); };
+  return [=] {
+    if (*workload == "pool") return runPoolStress(*elements ? *elements : 10'000'000, *seed, *json);
+    return runOctoBvhStress(*elements ? *elements : 1'000'000, *seed, *json);
+  };
 }};
 
 }  // namespace

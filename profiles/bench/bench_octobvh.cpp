@@ -1,0 +1,446 @@
+// bench_octobvh: OctoBVH vs LooseOctree vs Bullet's btDbvt on the same seeded brick builds.
+//
+//   build/release/bin/bench_octobvh --benchmark_counters_tabular=true
+//
+// Load/<Index>/<n>: the article's load workload: insert each brick, then query a box around it
+// (as a game does to hide adjacent faces); counters box_tests, ns_per_brick, bytes_per_element.
+// Edit/<Index>: insert, remove and update at 1M (ns per op). Overlap2m/<Index>, RayClosest200m/
+// <Index>, LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs
+// reversed child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again.
+// After the run a summary prints each comparison's ratio.
+#include <btBulletCollisionCommon.h>
+#include <BulletCollision/BroadphaseCollision/btDbvt.h>
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "collision/brick_workload.h"
+#include "collision/loose_octree.h"
+#include "collision/octobvh.h"
+#include "collision/seeded_random.h"
+
+namespace {
+
+using bw::Aabb;
+using bw::Vec3f;
+using Clock = std::chrono::steady_clock;
+
+std::map<std::string, double>& summary() {
+  static std::map<std::string, double> s;
+  return s;
+}
+
+const std::vector<Aabb>& build(uint32_t n) {
+  static std::map<uint32_t, std::vector<Aabb>> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) {
+    bw::BrickWorkloadParams p;
+    p.count = n;
+    p.seed = 2024;
+    p.clusters = 30;
+    p.extent = n >= 1'000'000 ? 4000.f : 2000.f;
+    it = cache.emplace(n, bw::generateBrickWorkload(p)).first;
+  }
+  return it->second;
+}
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// The box a game queries after placing a brick: the brick grown by a small margin.
+Aabb around(const Aabb& b) { return b.expanded(0.05f); }
+
+// ---------------------------------------------------------------- btDbvt adapter
+
+btDbvtVolume volume(const Aabb& b) {
+  return btDbvtVolume::FromMM(btVector3(b.min.x(), b.min.y(), b.min.z()), btVector3(b.max.x(), b.max.y(), b.max.z()));
+}
+
+struct CountHits : btDbvt::ICollide {
+  uint64_t hits = 0;
+  void Process(const btDbvtNode*) override { ++hits; }
+};
+
+struct ClosestRay : btDbvt::ICollide {
+  btVector3 from, dir;
+  float best;
+  const btDbvtNode* hit = nullptr;
+  void Process(const btDbvtNode* leaf) override {
+    // Exact AABB entry of the leaf (btDbvt's traversal does not prune by the best hit).
+    btScalar t0 = 0, t1 = best;
+    for (int i = 0; i < 3; ++i) {
+      const btScalar inv = dir[i] != 0 ? 1 / dir[i] : btScalar(1e30);
+      btScalar a = (leaf->volume.Mins()[i] - from[i]) * inv, c = (leaf->volume.Maxs()[i] - from[i]) * inv;
+      if (a > c) std::swap(a, c);
+      t0 = std::max(t0, a);
+      t1 = std::min(t1, c);
+    }
+    if (t0 <= t1 && t0 < best) {
+      best = t0;
+      hit = leaf;
+    }
+  }
+};
+
+// ---------------------------------------------------------------- load workload
+
+template <class Index>
+void loadWith(benchmark::State& state, const char* name) {
+  const uint32_t n = uint32_t(state.range(0));
+  const std::vector<Aabb>& bricks = build(n);
+  for (auto _ : state) {
+    Index index(typename Index::Config{n + 1024});
+    bw::QueryStats st;
+    uint64_t found = 0;
+    const auto t = Clock::now();
+    for (uint32_t i = 0; i < n; ++i) {
+      index.insert(bricks[i], 1, i);
+      index.overlap(around(bricks[i]), 1, [&](uint32_t) { ++found; }, &st);
+    }
+    const double s = secondsSince(t);
+    state.counters["box_tests"] = double(st.boxTests);
+    state.counters["box_tests_per_brick"] = double(st.boxTests) / n;
+    state.counters["ns_per_brick"] = s * 1e9 / n;
+    state.counters["hits_per_query"] = double(found) / n;
+    if constexpr (std::is_same_v<Index, bw::OctoBvh>) {
+      const auto m = index.memoryStats();
+      state.counters["bytes_per_element"] = double(m.totalBytes()) / n;
+      state.counters["bytes_per_node"] = double(m.nodeBytes) / double(m.nodes);
+    } else {
+      state.counters["bytes_per_element"] = double(index.nodeBytes() + index.elementBytes()) / n;
+    }
+    summary()[std::string("load_tests_") + name + "_" + std::to_string(n)] = double(st.boxTests);
+    summary()[std::string("load_s_") + name + "_" + std::to_string(n)] = s;
+  }
+}
+
+void Load_OctoBVH(benchmark::State& state) { loadWith<bw::OctoBvh>(state, "OctoBVH"); }
+void Load_LooseOctree(benchmark::State& state) { loadWith<bw::LooseOctree>(state, "LooseOctree"); }
+
+void Load_btDbvt(benchmark::State& state) {
+  const uint32_t n = uint32_t(state.range(0));
+  const std::vector<Aabb>& bricks = build(n);
+  for (auto _ : state) {
+    btDbvt tree;
+    CountHits hits;
+    const auto t = Clock::now();
+    for (uint32_t i = 0; i < n; ++i) {
+      tree.insert(volume(bricks[i]), nullptr);
+      tree.collideTV(tree.m_root, volume(around(bricks[i])), hits);
+    }
+    const double s = secondsSince(t);
+    state.counters["ns_per_brick"] = s * 1e9 / n;
+    state.counters["hits_per_query"] = double(hits.hits) / n;
+    // btDbvt keeps 2n-1 nodes (leaves + internal), each a btDbvtNode.
+    state.counters["bytes_per_element"] = double(sizeof(btDbvtNode)) * (2.0 * n - 1) / n;
+    summary()["load_s_btDbvt_" + std::to_string(n)] = s;
+  }
+}
+
+// ---------------------------------------------------------------- 1M prebuilt indices
+
+constexpr uint32_t kMillion = 1'000'000;
+
+template <class Index>
+Index& prebuilt() {
+  static std::unique_ptr<Index> index;
+  if (!index) {
+    index = std::make_unique<Index>(typename Index::Config{kMillion + 100'000});
+    const auto& b = build(kMillion);
+    for (uint32_t i = 0; i < kMillion; ++i) index->insert(b[i], 1, i);
+  }
+  return *index;
+}
+
+struct DbvtBuild {
+  btDbvt tree;
+  std::vector<btDbvtNode*> leaves;
+};
+DbvtBuild& prebuiltDbvt() {
+  static std::unique_ptr<DbvtBuild> d;
+  if (!d) {
+    d = std::make_unique<DbvtBuild>();
+    const auto& b = build(kMillion);
+    for (uint32_t i = 0; i < kMillion; ++i) d->leaves.push_back(d->tree.insert(volume(b[i]), nullptr));
+  }
+  return *d;
+}
+
+// Queries centred on random existing bricks so they land where the geometry is.
+std::vector<Vec3f> queryCentres(uint32_t count, uint64_t seed) {
+  const auto& b = build(kMillion);
+  bw::SeededRandom r(seed);
+  std::vector<Vec3f> out;
+  for (uint32_t i = 0; i < count; ++i) out.push_back(b[r.below(kMillion)].center());
+  return out;
+}
+
+std::vector<Vec3f> rayDirections(uint32_t count, uint64_t seed) {
+  bw::SeededRandom r(seed);
+  std::vector<Vec3f> out;
+  for (uint32_t i = 0; i < count; ++i) out.push_back(Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized());
+  return out;
+}
+
+// ---------------------------------------------------------------- edits at 1M
+
+template <class Index>
+void editsWith(benchmark::State& state, const char* name) {
+  Index& index = prebuilt<Index>();
+  const auto& b = build(kMillion);
+  constexpr uint32_t kOps = 20'000;
+  bw::SeededRandom r(7);
+  for (auto _ : state) {
+    // Remove kOps random bricks, insert them again, then move kOps bricks by a small step.
+    std::vector<uint32_t> handles;
+    std::vector<uint32_t> payload;
+    for (uint32_t i = 0; i < kOps; ++i) {
+      uint32_t h;
+      do h = r.below(kMillion);
+      while (!index.contains(h) || std::find(handles.begin(), handles.end(), h) != handles.end());
+      handles.push_back(h);
+    }
+    auto t = Clock::now();
+    for (uint32_t h : handles) {
+      payload.push_back(index.payload(h));
+      index.remove(h);
+    }
+    const double removeNs = secondsSince(t) * 1e9 / kOps;
+    t = Clock::now();
+    for (uint32_t i = 0; i < kOps; ++i) handles[i] = index.insert(b[payload[i]], 1, payload[i]);
+    const double insertNs = secondsSince(t) * 1e9 / kOps;
+    t = Clock::now();
+    for (uint32_t i = 0; i < kOps; ++i) {
+      const Aabb& o = b[payload[i]];
+      index.update(handles[i], {o.min + Vec3f(0.2f, 0, 0), o.max + Vec3f(0.2f, 0, 0)}, 1);
+    }
+    const double updateNs = secondsSince(t) * 1e9 / kOps;
+    for (uint32_t i = 0; i < kOps; ++i) index.update(handles[i], b[payload[i]], 1);
+    state.counters["insert_ns"] = insertNs;
+    state.counters["remove_ns"] = removeNs;
+    state.counters["update_ns"] = updateNs;
+    summary()[std::string("insert_ns_") + name] = insertNs;
+    summary()[std::string("remove_ns_") + name] = removeNs;
+  }
+}
+void Edit_OctoBVH(benchmark::State& state) { editsWith<bw::OctoBvh>(state, "OctoBVH"); }
+void Edit_LooseOctree(benchmark::State& state) { editsWith<bw::LooseOctree>(state, "LooseOctree"); }
+
+void Edit_btDbvt(benchmark::State& state) {
+  DbvtBuild& d = prebuiltDbvt();
+  const auto& b = build(kMillion);
+  constexpr uint32_t kOps = 20'000;
+  bw::SeededRandom r(7);
+  for (auto _ : state) {
+    std::vector<uint32_t> idx;
+    for (uint32_t i = 0; i < kOps; ++i) idx.push_back(r.below(kMillion));
+    std::sort(idx.begin(), idx.end());
+    idx.erase(std::unique(idx.begin(), idx.end()), idx.end());
+    auto t = Clock::now();
+    for (uint32_t i : idx) d.tree.remove(d.leaves[i]);
+    const double removeNs = secondsSince(t) * 1e9 / double(idx.size());
+    t = Clock::now();
+    for (uint32_t i : idx) d.leaves[i] = d.tree.insert(volume(b[i]), nullptr);
+    const double insertNs = secondsSince(t) * 1e9 / double(idx.size());
+    t = Clock::now();
+    for (uint32_t i : idx) {
+      btDbvtVolume v = volume({b[i].min + Vec3f(0.2f, 0, 0), b[i].max + Vec3f(0.2f, 0, 0)});
+      d.tree.update(d.leaves[i], v);
+    }
+    const double updateNs = secondsSince(t) * 1e9 / double(idx.size());
+    for (uint32_t i : idx) {
+      btDbvtVolume v = volume(b[i]);
+      d.tree.update(d.leaves[i], v);
+    }
+    state.counters["insert_ns"] = insertNs;
+    state.counters["remove_ns"] = removeNs;
+    state.counters["update_ns"] = updateNs;
+    summary()["insert_ns_btDbvt"] = insertNs;
+    summary()["remove_ns_btDbvt"] = removeNs;
+  }
+}
+
+// ---------------------------------------------------------------- overlap 2 m
+
+template <class Index>
+void overlapWith(benchmark::State& state, const char* name) {
+  const Index& index = prebuilt<Index>();
+  const auto centres = queryCentres(4096, 11);
+  bw::QueryStats st;
+  uint64_t hits = 0, q = 0;
+  for (auto _ : state) {
+    const Aabb box = Aabb::fromCenterHalf(centres[q++ & 4095], Vec3f::Constant(1.f));
+    index.overlap(box, 1, [&](uint32_t) { ++hits; }, &st);
+  }
+  state.counters["box_tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
+  state.counters["hits"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
+  summary()[std::string("overlap_tests_") + name] = double(st.boxTests) / double(state.iterations());
+}
+void Overlap2m_OctoBVH(benchmark::State& state) { overlapWith<bw::OctoBvh>(state, "OctoBVH"); }
+void Overlap2m_LooseOctree(benchmark::State& state) { overlapWith<bw::LooseOctree>(state, "LooseOctree"); }
+void Overlap2m_btDbvt(benchmark::State& state) {
+  DbvtBuild& d = prebuiltDbvt();
+  const auto centres = queryCentres(4096, 11);
+  CountHits hits;
+  uint64_t q = 0;
+  for (auto _ : state) {
+    const Aabb box = Aabb::fromCenterHalf(centres[q++ & 4095], Vec3f::Constant(1.f));
+    d.tree.collideTV(d.tree.m_root, volume(box), hits);
+  }
+  state.counters["hits"] = benchmark::Counter(double(hits.hits), benchmark::Counter::kAvgIterations);
+}
+
+// ---------------------------------------------------------------- rays
+
+template <class Index>
+void rayWith(benchmark::State& state, const char* key, float length, bw::RayChildOrder order) {
+  const Index& index = prebuilt<Index>();
+  const auto origins = queryCentres(4096, 13);
+  const auto dirs = rayDirections(4096, 14);
+  bw::QueryStats st;
+  uint64_t hits = 0, q = 0;
+  for (auto _ : state) {
+    const uint64_t i = q++ & 4095;
+    // Start 3 units outside the brick the ray is aimed from, so it does not begin inside it.
+    const bw::Ray ray = bw::Ray::make(origins[i] + dirs[i] * 3.f, dirs[i], length);
+    hits += index.raycastClosest(ray, 1, &st, bw::AabbRayExact{}, order).hit();
+  }
+  state.counters["box_tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
+  state.counters["hit_rate"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
+  summary()[key] = double(st.boxTests) / double(state.iterations());
+}
+void RayClosest200m_OctoBVH(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "ray_tests_OctoBVH", 200.f, bw::RayChildOrder::FrontToBack); }
+void RayClosest200m_LooseOctree(benchmark::State& s) { rayWith<bw::LooseOctree>(s, "ray_tests_LooseOctree", 200.f, bw::RayChildOrder::FrontToBack); }
+void RayOrder_OctoBVH_FrontToBack(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "order_tests_front", 2000.f, bw::RayChildOrder::FrontToBack); }
+void RayOrder_OctoBVH_Reversed(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "order_tests_reversed", 2000.f, bw::RayChildOrder::Reversed); }
+
+void RayClosest200m_btDbvt(benchmark::State& state) {
+  DbvtBuild& d = prebuiltDbvt();
+  const auto origins = queryCentres(4096, 13);
+  const auto dirs = rayDirections(4096, 14);
+  uint64_t hits = 0, q = 0;
+  for (auto _ : state) {
+    const uint64_t i = q++ & 4095;
+    const Vec3f o = origins[i] + dirs[i] * 3.f, e = o + dirs[i] * 200.f;
+    ClosestRay cb;
+    cb.from = btVector3(o.x(), o.y(), o.z());
+    cb.dir = btVector3(dirs[i].x(), dirs[i].y(), dirs[i].z());
+    cb.best = 200.f;
+    btDbvt::rayTest(d.tree.m_root, cb.from, btVector3(e.x(), e.y(), e.z()), cb);
+    hits += cb.hit != nullptr;
+  }
+  state.counters["hit_rate"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
+}
+
+// Long rays across the whole build from outside it, aimed at a random brick (they hit).
+template <class Index>
+void longRayWith(benchmark::State& state, const char* key) {
+  const Index& index = prebuilt<Index>();
+  const auto targets = queryCentres(4096, 17);
+  const auto dirs = rayDirections(4096, 18);
+  bw::QueryStats st;
+  uint64_t q = 0;
+  for (auto _ : state) {
+    const uint64_t i = q++ & 4095;
+    const Vec3f origin = targets[i] - dirs[i] * 3000.f;
+    benchmark::DoNotOptimize(index.raycastClosest(bw::Ray::make(origin, dirs[i], 6000.f), 1, &st));
+  }
+  state.counters["box_tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
+  summary()[key] = double(st.boxTests) / double(state.iterations());
+}
+void LongRay_OctoBVH(benchmark::State& s) { longRayWith<bw::OctoBvh>(s, "long_tests_OctoBVH"); }
+void LongRay_LooseOctree(benchmark::State& s) { longRayWith<bw::LooseOctree>(s, "long_tests_LooseOctree"); }
+
+// 1000 moved bricks absorbed by the index, then the same rays: no rebuild, no slowdown.
+void EditsThenRays_OctoBVH(benchmark::State& state) {
+  bw::OctoBvh& index = prebuilt<bw::OctoBvh>();
+  const auto& b = build(kMillion);
+  const auto origins = queryCentres(4096, 13);
+  const auto dirs = rayDirections(4096, 14);
+  auto rays = [&] {
+    const auto t = Clock::now();
+    for (int i = 0; i < 4096; ++i)
+      benchmark::DoNotOptimize(index.raycastClosest(bw::Ray::make(origins[i] + dirs[i] * 3.f, dirs[i], 200.f), 1));
+    return secondsSince(t) * 1e9 / 4096;
+  };
+  for (auto _ : state) {
+    const double before = rays();
+    bw::SeededRandom r(31);
+    std::vector<uint32_t> moved;
+    const auto t = Clock::now();
+    for (int k = 0; k < 1000; ++k) {
+      const uint32_t h = r.below(kMillion);
+      if (!index.contains(h)) continue;
+      const Aabb& o = b[index.payload(h)];
+      index.update(h, {o.min + Vec3f(0, 0.4f, 0), o.max + Vec3f(0, 0.4f, 0)}, 1);
+      moved.push_back(h);
+    }
+    const double editMs = secondsSince(t) * 1e3;
+    const double after = rays();
+    for (uint32_t h : moved) index.update(h, b[index.payload(h)], 1);
+    state.counters["edits_1000_ms"] = editMs;
+    state.counters["ray_ns_before"] = before;
+    state.counters["ray_ns_after"] = after;
+  }
+}
+
+void printSummary() {
+  auto& s = summary();
+  auto get = [&](const std::string& k) { return s.count(k) ? s[k] : 0.0; };
+  std::printf("\n== Comparisons (same run)\n");
+  for (uint32_t n : {100'000u, 1'000'000u, 4'000'000u}) {
+    const std::string sn = std::to_string(n);
+    if (!get("load_tests_OctoBVH_" + sn) || !get("load_tests_LooseOctree_" + sn)) continue;
+    std::printf("load %8u bricks: box tests LooseOctree/OctoBVH = %.2fx (%.3g vs %.3g), time LooseOctree/OctoBVH = %.2fx",
+                n, get("load_tests_LooseOctree_" + sn) / get("load_tests_OctoBVH_" + sn), get("load_tests_LooseOctree_" + sn),
+                get("load_tests_OctoBVH_" + sn), get("load_s_LooseOctree_" + sn) / get("load_s_OctoBVH_" + sn));
+    if (get("load_s_btDbvt_" + sn)) std::printf(", btDbvt/OctoBVH = %.2fx", get("load_s_btDbvt_" + sn) / get("load_s_OctoBVH_" + sn));
+    std::printf("\n");
+  }
+  if (get("order_tests_front"))
+    std::printf("ray child order: reversed/front-to-back box tests = %.2fx (%.0f vs %.0f)\n",
+                get("order_tests_reversed") / get("order_tests_front"), get("order_tests_reversed"), get("order_tests_front"));
+  if (get("long_tests_OctoBVH"))
+    std::printf("long rays: LooseOctree/OctoBVH box tests = %.2fx (%.0f vs %.0f)\n",
+                get("long_tests_LooseOctree") / get("long_tests_OctoBVH"), get("long_tests_LooseOctree"), get("long_tests_OctoBVH"));
+  if (get("ray_tests_OctoBVH"))
+    std::printf("200 m rays: LooseOctree/OctoBVH box tests = %.2fx\n", get("ray_tests_LooseOctree") / get("ray_tests_OctoBVH"));
+  if (get("overlap_tests_OctoBVH"))
+    std::printf("2 m overlaps: LooseOctree/OctoBVH box tests = %.2fx\n", get("overlap_tests_LooseOctree") / get("overlap_tests_OctoBVH"));
+  if (get("insert_ns_OctoBVH"))
+    std::printf("edits at 1M: insert ns OctoBVH %.0f, LooseOctree %.0f, btDbvt %.0f; remove ns %.0f, %.0f, %.0f\n",
+                get("insert_ns_OctoBVH"), get("insert_ns_LooseOctree"), get("insert_ns_btDbvt"), get("remove_ns_OctoBVH"),
+                get("remove_ns_LooseOctree"), get("remove_ns_btDbvt"));
+}
+
+}  // namespace
+
+BENCHMARK(Load_OctoBVH)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(Load_LooseOctree)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(Load_btDbvt)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(Edit_OctoBVH)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(Edit_LooseOctree)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(Edit_btDbvt)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(Overlap2m_OctoBVH)->Unit(benchmark::kMicrosecond);
+BENCHMARK(Overlap2m_LooseOctree)->Unit(benchmark::kMicrosecond);
+BENCHMARK(Overlap2m_btDbvt)->Unit(benchmark::kMicrosecond);
+BENCHMARK(RayClosest200m_OctoBVH)->Unit(benchmark::kMicrosecond);
+BENCHMARK(RayClosest200m_LooseOctree)->Unit(benchmark::kMicrosecond);
+BENCHMARK(RayClosest200m_btDbvt)->Unit(benchmark::kMicrosecond);
+BENCHMARK(RayOrder_OctoBVH_FrontToBack)->Unit(benchmark::kMicrosecond);
+BENCHMARK(RayOrder_OctoBVH_Reversed)->Unit(benchmark::kMicrosecond);
+BENCHMARK(LongRay_OctoBVH)->Unit(benchmark::kMicrosecond);
+BENCHMARK(LongRay_LooseOctree)->Unit(benchmark::kMicrosecond);
+BENCHMARK(EditsThenRays_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  printSummary();
+  return 0;
+}
