@@ -4,6 +4,7 @@
 /// its own virtual pool.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "collision/aabb.h"
 
@@ -67,12 +68,14 @@ struct ElementRecord {
 static_assert(sizeof(ElementRecord) == 32);
 
 /// Smallest level L (clamped to [kMinLevel, kMaxLevel]) with 2^L >= extent.
+/// note: read from the float's exponent and mantissa bits: exact, and cheap enough to call on
+/// every element a refit touches. Extents are finite and >= 0 (validated on insert).
 inline int minLevelForExtent(float extent) {
-  if (!(extent > std::ldexp(1.f, kMinLevel))) return kMinLevel;
-  int e;
-  const float f = std::frexp(extent, &e);  // extent = f * 2^e, f in [0.5, 1)
-  const int level = (f == 0.5f) ? e - 1 : e;
-  return level > kMaxLevel ? kMaxLevel : level;
+  uint32_t bits;
+  std::memcpy(&bits, &extent, 4);
+  const int exponent = int(bits >> 23) - 127;         // extent = 1.m * 2^exponent (normal floats)
+  const int level = exponent + ((bits & 0x7FFFFF) ? 1 : 0);  // round up unless a power of two
+  return level < kMinLevel ? kMinLevel : (level > kMaxLevel ? kMaxLevel : level);
 }
 
 inline int minLevelOf(const ElementRecord& r) {

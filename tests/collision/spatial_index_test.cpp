@@ -406,3 +406,31 @@ TEST(OctoBvh, RayChildOrderIsFrontToBack) {
 
 }  // namespace
 }  // namespace bw
+
+namespace bw {
+namespace {
+
+TEST(OctoBvhLayout, MinLevelIsTheSmallestCoveringPowerOfTwo) {
+  using octobvh::minLevelForExtent;
+  EXPECT_EQ(minLevelForExtent(0.f), octobvh::kMinLevel);
+  EXPECT_EQ(minLevelForExtent(1e-30f), octobvh::kMinLevel);
+  EXPECT_EQ(minLevelForExtent(1.f), 0);
+  EXPECT_EQ(minLevelForExtent(std::nextafter(1.f, 2.f)), 1);
+  EXPECT_EQ(minLevelForExtent(0.5f), -1);
+  EXPECT_EQ(minLevelForExtent(0.04f), -4);
+  EXPECT_EQ(minLevelForExtent(500.f), 9);
+  EXPECT_EQ(minLevelForExtent(512.f), 9);
+  EXPECT_EQ(minLevelForExtent(3e9f), octobvh::kMaxLevel);
+  SeededRandom r(1);
+  for (int i = 0; i < 100000; ++i) {
+    const float e = float(r.logUniform(1e-4, 1e9));
+    const int l = minLevelForExtent(e);
+    ASSERT_GE(std::ldexp(1.0, l), double(e));
+    if (l > octobvh::kMinLevel) {
+      ASSERT_LT(std::ldexp(1.0, l - 1), double(e));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace bw
