@@ -1,0 +1,195 @@
+#include "collision/brick_narrowphase.h"
+
+#include <btBulletCollisionCommon.h>
+#include <BulletCollision/CollisionDispatch/btBoxBoxDetector.h>
+#include <BulletCollision/CollisionShapes/btConvexPointCloudShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "collision/brick_geometry.h"
+#include "collision/input_validation.h"
+
+namespace bw {
+
+Vec3f QueryShape::localHalfExtents() const {
+  switch (kind) {
+    case Kind::Sphere: return Vec3f::Constant(radius);
+    case Kind::Box: return halfExtents;
+    case Kind::Capsule: return Vec3f(radius, radius, radius + halfHeight);
+    case Kind::Hull: {
+      Vec3f e = Vec3f::Zero();
+      for (uint32_t i = 0; i < pointCount; ++i) e = e.cwiseMax(points[i].cwiseAbs());
+      return e;
+    }
+  }
+  return Vec3f::Zero();
+}
+
+void QueryShape::validate(const char* context) const {
+  switch (kind) {
+    case Kind::Sphere: requireInRange(radius, 1e-4, 1e7, context, "sphere radius"); break;
+    case Kind::Box:
+      for (int i = 0; i < 3; ++i) requireInRange(halfExtents[i], 1e-4, 1e7, context, "box half extent");
+      break;
+    case Kind::Capsule:
+      requireInRange(radius, 1e-4, 1e7, context, "capsule radius");
+      requireInRange(halfHeight, 0, 1e7, context, "capsule half height");
+      break;
+    case Kind::Hull:
+      if (!points || pointCount < 4) throw InvalidInput(std::string(context) + ": a hull needs at least 4 points");
+      for (uint32_t i = 0; i < pointCount; ++i) requireFinite(points[i], context, "hull point");
+      break;
+  }
+}
+
+namespace {
+
+btVector3 bt(const Vec3f& v) { return {v.x(), v.y(), v.z()}; }
+Vec3f fromBt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+btTransform brickTransform(const Brick& b) {
+  btMatrix3x3 m;
+  const Mat3f r = b.rotation.matrix();
+  m.setValue(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2));
+  return btTransform(m, bt(b.position));
+}
+
+btTransform poseTransform(const LocalPose& p) {
+  return btTransform(btQuaternion(p.rotation.x(), p.rotation.y(), p.rotation.z(), p.rotation.w()), bt(p.position));
+}
+
+struct BoxBoxCollector : btDiscreteCollisionDetectorInterface::Result {
+  LocalContact* out;
+  int count = 0;
+  uint32_t feature, material;
+  void setShapeIdentifiersA(int, int) override {}
+  void setShapeIdentifiersB(int, int) override {}
+  void addContactPoint(const btVector3& normalOnB, const btVector3& pointOnB, btScalar depth) override {
+    // Bullet: normal from B (brick) to A (shape), point on B, depth < 0 when penetrating.
+    if (count < kMaxContactsPerBrick && depth <= 0)
+      out[count++] = {fromBt(pointOnB), fromBt(normalOnB), -float(depth), feature, material};
+  }
+};
+
+// Collides a Bullet convex shape for the query against a Bullet convex shape for the brick.
+// note: btGjkEpaSolver2::Distance works on the cores (margins excluded: a sphere is a point, a
+// capsule a segment), so the gap is the core distance minus both margins; when the cores
+// overlap, Penetration works on the full shapes. Both report the normal from the brick (shape
+// 1) towards the query shape (shape 0), and witnesses[1] on the brick's core.
+int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConvexShape& brick, const btTransform& trBrick,
+           uint32_t feature, uint32_t material, float margin, LocalContact* out) {
+  btGjkEpaSolver2::sResults res;
+  const btVector3 guess = trShape.getOrigin() - trBrick.getOrigin();
+  const float margins = float(shape.getMargin() + brick.getMargin());
+  if (btGjkEpaSolver2::Distance(&shape, trShape, &brick, trBrick, guess, res)) {
+    const float gap = float(res.distance) - margins;
+    if (gap >= margin) return 0;
+    const Vec3f n = fromBt(res.normal).normalized();
+    if (!n.allFinite()) return 0;
+    const Vec3f onBrick = fromBt(res.witnesses[1]) + n * float(brick.getMargin());
+    out[0] = {onBrick, n, -gap, feature, material};
+    return 1;
+  }
+  if (!btGjkEpaSolver2::Penetration(&shape, trShape, &brick, trBrick, guess, res)) return 0;
+  Vec3f n = fromBt(res.normal);
+  if (!n.allFinite() || n.squaredNorm() < 1e-12f) return 0;
+  out[0] = {fromBt(res.witnesses[1]), n.normalized(), -float(res.distance), feature, material};
+  return 1;
+}
+
+}  // namespace
+
+int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
+                      float speculativeMargin, LocalContact* out) {
+  const btTransform trShape = poseTransform(pose);
+  const btTransform trBrick = brickTransform(b);
+  if (shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box && speculativeMargin <= 0.f) {
+    btBoxShape a(bt(shape.halfExtents)), c(bt(b.halfSize));
+    btBoxBoxDetector det(&a, &c);
+    btDiscreteCollisionDetectorInterface::ClosestPointInput in;
+    in.m_transformA = trShape;
+    in.m_transformB = trBrick;
+    BoxBoxCollector col;
+    col.out = out;
+    col.feature = feature;
+    col.material = b.material;
+    det.getClosestPoints(in, col, nullptr);
+    return col.count;
+  }
+  // Brick as a zero-margin point cloud over stack vertices (no allocation).
+  btVector3 verts[kMaxBrickVertices];
+  Vec3f v[kMaxBrickVertices];
+  const int nv = canonicalBrickVertices(b, v);
+  for (int i = 0; i < nv; ++i) verts[i] = bt(v[i]);
+  btConvexPointCloudShape brick(verts, nv, btVector3(1, 1, 1), false);
+  brick.setMargin(0);
+  brick.recalcLocalAabb();
+  switch (shape.kind) {
+    case QueryShape::Kind::Sphere: {
+      btSphereShape s(shape.radius);
+      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
+    }
+    case QueryShape::Kind::Box: {
+      btBoxShape s(bt(shape.halfExtents));
+      s.setMargin(0);
+      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
+    }
+    case QueryShape::Kind::Capsule: {
+      btCapsuleShapeZ s(shape.radius, 2 * shape.halfHeight);
+      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
+    }
+    case QueryShape::Kind::Hull: {
+      // note: one buffer per thread, grown on first use only, so hull contacts do not allocate.
+      thread_local std::vector<btVector3> pts;
+      pts.resize(shape.pointCount);
+      for (uint32_t i = 0; i < shape.pointCount; ++i) pts[i] = bt(shape.points[i]);
+      btConvexPointCloudShape s(pts.data(), int(shape.pointCount), btVector3(1, 1, 1), false);
+      s.setMargin(0);
+      s.recalcLocalAabb();
+      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
+    }
+  }
+  return 0;
+}
+
+int reduceManifold(LocalContact* c, int n, int maxOut) {
+  if (n <= maxOut) return n;
+  // 1. deepest; 2. farthest from it; 3. largest triangle; 4. largest area added (quad).
+  auto swapTo = [&](int dst, int src) { std::swap(c[dst], c[src]); };
+  int best = 0;
+  for (int i = 1; i < n; ++i)
+    if (c[i].depth > c[best].depth) best = i;
+  swapTo(0, best);
+  int kept = 1;
+  while (kept < maxOut) {
+    int pick = -1;
+    float score = -1.f;
+    for (int i = kept; i < n; ++i) {
+      float s;
+      if (kept == 1) {
+        s = (c[i].position - c[0].position).squaredNorm();
+      } else if (kept == 2) {
+        s = (c[1].position - c[0].position).cross(c[i].position - c[0].position).squaredNorm();
+      } else {
+        // distance to the triangle's plane area proxy: sum of areas with each kept edge
+        s = 0.f;
+        for (int a = 0; a < kept; ++a) {
+          const int bIdx = (a + 1) % kept;
+          s = std::max(s, (c[bIdx].position - c[a].position).cross(c[i].position - c[a].position).squaredNorm());
+        }
+      }
+      if (s > score) {
+        score = s;
+        pick = i;
+      }
+    }
+    if (pick < 0) break;
+    swapTo(kept++, pick);
+  }
+  return kept;
+}
+
+}  // namespace bw

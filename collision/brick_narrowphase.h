@@ -1,0 +1,42 @@
+#pragma once
+/// Narrowphase between a query shape and one brick, in the grid's local frame.
+///
+/// Method (documented choice): box vs box-shaped brick uses Bullet's btBoxBoxDetector (up to 4
+/// points per pair, the common case on brick floors); every other pair uses Bullet's GJK/EPA
+/// (btGjkEpaSolver2) on the exact brick vertices (one point per pair), with zero margins so
+/// contacts are exact. A non-penetrating pair closer than `speculativeMargin` gives one contact
+/// with negative depth (the gap), for speculative contacts.
+#include <cstdint>
+
+#include "collision/brick.h"
+#include "collision/query_shape.h"
+
+namespace bw {
+
+/// A contact in the grid frame: point on the brick, normal from the brick towards the shape.
+struct LocalContact {
+  Vec3f position;
+  Vec3f normal;
+  float depth;       ///< > 0 penetration, < 0 speculative gap
+  uint32_t feature;  ///< brick id (or LOD subtree tag)
+  uint32_t material;
+};
+
+/// Pose of a query shape in the grid frame.
+struct LocalPose {
+  Vec3f position;
+  Quatf rotation;
+};
+
+constexpr int kMaxContactsPerBrick = 4;
+
+/// Appends up to kMaxContactsPerBrick contacts between shape (at pose) and brick b to out.
+/// Returns how many were added.
+int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
+                      float speculativeMargin, LocalContact* out);
+
+/// Reduces n contacts to at most maxOut in place (deepest first, then the points that span the
+/// largest area). Returns the new count. Deterministic for a given input order.
+int reduceManifold(LocalContact* contacts, int n, int maxOut);
+
+}  // namespace bw

@@ -1,0 +1,399 @@
+// Brick shapes and grids: exact geometry, mass properties, raycasts and contacts against brute
+// force over every brick, collision LOD, convex approximation, grid vs grid, edits, bad input.
+#include "collision/brick_grid.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+
+#include "collision/input_validation.h"
+#include "collision/seeded_random.h"
+
+namespace bw {
+namespace {
+
+Brick randomBrick(SeededRandom& r, const Vec3f& position, float scale = 1.f) {
+  Brick b;
+  b.position = position;
+  b.halfSize = Vec3f(float(r.logUniform(0.04, 1.0)), float(r.logUniform(0.04, 1.0)), float(r.logUniform(0.04, 1.0))) * scale;
+  b.shape = BrickShape(r.below(4));
+  b.sides = uint8_t(3 + r.below(14));
+  b.rotation = AxisRotation::fromIndex(int(r.below(24)));
+  b.filter = 1u << r.below(3);
+  b.material = uint8_t(r.below(4));
+  return b;
+}
+
+// A grid of random bricks on a jittered lattice (neighbours touch or nearly), plus a few large ones.
+std::vector<Brick> randomBuild(uint64_t seed, int n, const Vec3f& offset) {
+  SeededRandom r(seed);
+  std::vector<Brick> out;
+  const int side = int(std::ceil(std::cbrt(double(n))));
+  for (int i = 0; i < n; ++i) {
+    const Vec3f cell(float(i % side), float((i / side) % side), float(i / (side * side)));
+    Brick b = randomBrick(r, offset + cell * 2.f + Vec3f(float(r.uniform(-0.2, 0.2)), float(r.uniform(-0.2, 0.2)), 0.f));
+    if (i % 97 == 0) b.halfSize *= 6.f;  // large bricks among small ones
+    out.push_back(b);
+  }
+  return out;
+}
+
+TEST(BrickGeometry, MomentsMatchNumericalIntegration) {
+  SeededRandom r(1);
+  for (int k = 0; k < 24; ++k) {
+    Brick b = randomBrick(r, Vec3f(float(r.uniform(-5, 5)), 1.f, 2.f));
+    b.halfSize = Vec3f(float(r.uniform(0.3, 1.5)), float(r.uniform(0.3, 1.5)), float(r.uniform(0.3, 1.5)));
+    b.shape = BrickShape(k % 4);
+    const Vec3d ref(0.5, -1, 2);
+    const ShapeMoments exact = brickMoments(b, 2.0, ref);
+    // Midpoint integration over the bounds on a 64^3 lattice.
+    const Aabb box = brickBounds(b);
+    const int n = 64;
+    const Vec3d step = box.extent().cast<double>() / n;
+    const double cell = step.prod();
+    ShapeMoments num;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        for (int l = 0; l < n; ++l) {
+          const Vec3d p = box.min.cast<double>() + Vec3d((i + 0.5) * step.x(), (j + 0.5) * step.y(), (l + 0.5) * step.z());
+          if (!brickContains(b, p.cast<float>())) continue;
+          const Vec3d q = p - ref;
+          num.volume += 2.0 * cell;
+          num.first += 2.0 * cell * q;
+          num.second += 2.0 * cell * q * q.transpose();
+        }
+    const double scale = box.extent().maxCoeff();
+    EXPECT_NEAR(num.volume, exact.volume, 0.03 * exact.volume) << "shape " << k % 4;
+    EXPECT_LT((num.first - exact.first).norm(), 0.03 * exact.volume * (scale + ref.norm())) << "shape " << k % 4;
+    EXPECT_LT((num.second - exact.second).norm(), 0.05 * exact.second.norm()) << "shape " << k % 4;
+  }
+}
+
+TEST(BrickGeometry, BoundsAreExactForEveryShapeAndRotation) {
+  SeededRandom r(2);
+  for (int k = 0; k < 2000; ++k) {
+    const Brick b = randomBrick(r, Vec3f(float(r.uniform(-100, 100)), 0, 3));
+    Vec3f v[kMaxBrickVertices];
+    const int n = brickVertices(b, v);
+    Aabb tight = Aabb::empty();
+    for (int i = 0; i < n; ++i) tight.merge(v[i]);
+    const Aabb got = brickBounds(b);
+    ASSERT_LT((got.min - tight.min).cwiseAbs().maxCoeff(), 1e-5f * (1 + got.extent().maxCoeff()));
+    ASSERT_LT((got.max - tight.max).cwiseAbs().maxCoeff(), 1e-5f * (1 + got.extent().maxCoeff()));
+    for (int i = 0; i < n; ++i) ASSERT_TRUE(brickContains(b, v[i], 1e-4f));
+  }
+}
+
+TEST(BrickGeometry, RayEntersOnTheSurface) {
+  SeededRandom r(3);
+  int hits = 0;
+  for (int k = 0; k < 5000; ++k) {
+    const Brick b = randomBrick(r, Vec3f::Zero());
+    const Vec3f o = Vec3f(float(r.normal()), float(r.normal()), float(r.normal())) * 2.f;
+    // Aim at a random point of the bounds so most rays hit; some stay axis-parallel.
+    const Aabb box = brickBounds(b);
+    const Vec3f target(float(r.uniform(box.min.x(), box.max.x())), float(r.uniform(box.min.y(), box.max.y())),
+                       float(r.uniform(box.min.z(), box.max.z())));
+    Vec3f d = target - o;
+    if (k % 5 == 0) d[k % 3] = 0.f;
+    if (d.isZero()) continue;
+    float t;
+    Vec3f n;
+    if (!rayBrick(b, Ray::make(o, d.normalized()), 100.f, t, n)) continue;
+    ++hits;
+    const Vec3f p = o + d.normalized() * t;
+    ASSERT_TRUE(brickContains(b, p, 1e-4f));
+    if (t > 1e-3f) {
+      ASSERT_FALSE(brickContains(b, o + d.normalized() * (t - 1e-3f), 0.f)) << "entered earlier than reported";
+      ASSERT_LE(n.dot(d.normalized()), 1e-5f) << "normal faces the ray";
+    }
+  }
+  EXPECT_GT(hits, 500);
+}
+
+// Direct sum of every brick's moments, compared with the incrementally kept properties.
+// The sum is taken about `reference` (near the bricks): about the origin, a build 1e6 away would
+// lose ~1e-6 of its inertia to cancellation in the reference itself.
+void expectMassMatchesDirectSum(const BrickGrid& grid, const BrickGrid::Config& config, const Vec3d& reference) {
+  ShapeMoments sum;
+  grid.forEachBrick([&](uint32_t id) { sum += brickMoments(grid.brick(id), config.density[grid.brick(id).material], reference); });
+  const MassProperties m = grid.massProperties();
+  ASSERT_NEAR(m.mass, sum.volume, 1e-9 * sum.volume);
+  const Vec3d comRel = sum.first / sum.volume;
+  const Vec3d com = reference + comRel;
+  EXPECT_LT((m.centerOfMass - com).norm(), 1e-6 * (1 + com.norm()));
+  const Mat3d c = sum.second - sum.volume * comRel * comRel.transpose();
+  const Mat3d inertia = c.trace() * Mat3d::Identity() - c;
+  EXPECT_LT((m.inertia - inertia).norm(), 1e-8 * inertia.norm());
+}
+
+TEST(BrickGrid, MassPropertiesFollowRandomEditsAndMatchDirectSums) {
+  for (const Vec3f& offset : {Vec3f(0, 0, 0), Vec3f(1e6f, -2e5f, 3e5f)}) {
+    BrickGrid::Config config;
+    config.density[1] = 2.5f;
+    config.density[3] = 0.3f;
+    BrickGrid grid(config);
+    const std::vector<Brick> build = randomBuild(4, 3000, offset);
+    std::vector<uint32_t> ids;
+    for (const Brick& b : build) ids.push_back(grid.placeBrick(b));
+    expectMassMatchesDirectSum(grid, config, offset.cast<double>());
+    SeededRandom r(5);
+    for (int k = 0; k < 2000; ++k) {
+      const size_t i = r.below(uint32_t(ids.size()));
+      grid.removeBrick(ids[i]);
+      ids[i] = ids.back();
+      ids.pop_back();
+      if (k % 3 == 0) ids.push_back(grid.placeBrick(randomBrick(r, offset + Vec3f(float(r.uniform(0, 30)), float(r.uniform(0, 30)), float(r.uniform(0, 30))))));
+    }
+    expectMassMatchesDirectSum(grid, config, offset.cast<double>());
+    grid.index().validate();
+    for (uint32_t id : ids) grid.removeBrick(id);
+    EXPECT_EQ(grid.massProperties().mass, 0.0);
+  }
+}
+
+TEST(BrickGrid, RaycastsMatchBruteForceOverEveryBrick) {
+  BrickGrid grid;
+  for (const Brick& b : randomBuild(6, 4000, Vec3f(-10, -10, -10))) grid.placeBrick(b);
+  SeededRandom r(7);
+  int hits = 0;
+  for (int q = 0; q < 400; ++q) {
+    const Vec3f o(float(r.uniform(-20, 20)), float(r.uniform(-20, 20)), float(r.uniform(-20, 20)));
+    Vec3f d(float(r.normal()), float(r.normal()), float(r.normal()));
+    if (q % 4 == 0) d = Vec3f::Zero(), d[q % 3] = 1.f;
+    const Ray ray = Ray::make(o, d.normalized(), q % 2 ? 60.f : std::numeric_limits<float>::infinity());
+    const uint32_t mask = q % 3 ? 0xFFFFFFFFu : 2u;
+    float best = std::numeric_limits<float>::infinity();
+    grid.forEachBrick([&](uint32_t id) {
+      const Brick& b = grid.brick(id);
+      float t;
+      Vec3f n;
+      if ((b.filter & mask) && rayBrick(b, ray, ray.maxT, t, n)) best = std::min(best, t);
+    });
+    const GridRayHit h = grid.raycast(ray, mask);
+    ASSERT_EQ(h.hit(), best < std::numeric_limits<float>::infinity()) << "ray " << q;
+    if (h.hit()) {
+      ++hits;
+      ASSERT_EQ(h.t, best) << "ray " << q;
+      ASSERT_TRUE(grid.brick(h.brick).filter & mask);
+    }
+  }
+  EXPECT_GT(hits, 50);
+}
+
+QueryShape shapeFor(int k, std::vector<Vec3f>& hullPoints) {
+  switch (k % 4) {
+    case 0: return QueryShape::sphere(0.7f);
+    case 1: return QueryShape::box(Vec3f(0.9f, 0.5f, 0.3f));
+    case 2: return QueryShape::capsule(0.4f, 0.8f);
+    default: {
+      hullPoints.clear();
+      for (int i = 0; i < 8; ++i) hullPoints.emplace_back((i & 1) ? 0.6f : -0.6f, (i & 2) ? 0.4f : -0.4f, (i & 4) ? 0.5f : -0.5f);
+      hullPoints.emplace_back(0.f, 0.f, 0.9f);
+      return QueryShape::hull(hullPoints.data(), uint32_t(hullPoints.size()));
+    }
+  }
+}
+
+struct ContactKey {
+  uint32_t feature;
+  float depth;
+  bool operator<(const ContactKey& o) const { return feature < o.feature || (feature == o.feature && depth < o.depth); }
+};
+
+TEST(BrickGrid, ContactsMatchBruteForceOverEveryBrick) {
+  BrickGrid grid;
+  for (const Brick& b : randomBuild(8, 3000, Vec3f::Zero())) grid.placeBrick(b);
+  SeededRandom r(9);
+  std::vector<Vec3f> hull;
+  int withContacts = 0;
+  for (int q = 0; q < 300; ++q) {
+    const QueryShape shape = shapeFor(q, hull);
+    const LocalPose pose{Vec3f(float(r.uniform(-1, 30)), float(r.uniform(-1, 30)), float(r.uniform(-1, 30))),
+                         Quatf(Eigen::AngleAxisf(float(r.uniform(0, 6.28)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized()))};
+    ContactParams params;
+    params.lodFraction = 0.f;
+    params.speculativeMargin = q % 2 ? 0.05f : 0.f;
+    std::vector<LocalContact> got;
+    grid.collideLocal(shape, pose, params, got);
+    std::vector<LocalContact> expected;
+    LocalContact buf[kMaxContactsPerBrick];
+    grid.forEachBrick([&](uint32_t id) {
+      const int n = collideShapeBrick(shape, pose, grid.brick(id), id, params.speculativeMargin, buf);
+      expected.insert(expected.end(), buf, buf + n);
+    });
+    std::vector<ContactKey> a, b;
+    for (auto& c : got) a.push_back({c.feature, c.depth});
+    for (auto& c : expected) b.push_back({c.feature, c.depth});
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    ASSERT_EQ(a.size(), b.size()) << "query " << q;
+    for (size_t i = 0; i < a.size(); ++i) ASSERT_TRUE(a[i].feature == b[i].feature && a[i].depth == b[i].depth);
+    withContacts += !got.empty();
+    for (const LocalContact& c : got) {
+      ASSERT_NEAR(c.normal.norm(), 1.f, 1e-4f);
+      if (c.depth > 0) {
+        ASSERT_TRUE(brickContains(grid.brick(c.feature), c.position, 2e-3f)) << "contact point off the brick";
+      }
+    }
+  }
+  EXPECT_GT(withContacts, 50);
+}
+
+TEST(BrickGrid, RestingBoxGetsAFourPointManifoldWithUpNormals) {
+  BrickGrid grid;
+  // A floor of 10x10 plates.
+  for (int x = 0; x < 10; ++x)
+    for (int y = 0; y < 10; ++y) {
+      Brick b;
+      b.position = Vec3f(float(x), float(y), 0.f);
+      b.halfSize = Vec3f(0.5f, 0.5f, 0.08f);
+      grid.placeBrick(b);
+    }
+  ContactScratch scratch;
+  std::vector<Contact> contacts;
+  const RigidTransform gridPose{Vec3d(1e7, -1e7, 5e6), Quatf::Identity()};
+  const RigidTransform boxPose{Vec3d(1e7 + 4.3, -1e7 + 4.6, 5e6 + 0.08 + 0.25 - 0.01), Quatf::Identity()};
+  const size_t n = grid.collide(gridPose, QueryShape::box(Vec3f(0.5f, 0.5f, 0.25f)), boxPose, ContactParams{}, scratch, contacts);
+  ASSERT_EQ(n, 4u);
+  for (const Contact& c : contacts) {
+    EXPECT_NEAR(c.normal.z(), 1.f, 1e-4f);
+    EXPECT_NEAR(c.depth, 0.01f, 2e-3f) << "far from the origin the depth keeps its precision";
+    EXPECT_NEAR(c.position.z(), 5e6 + 0.08, 1e-3);
+  }
+}
+
+TEST(BrickGrid, LodCollidesSmallSubtreesAsBoxesAndNeverLosesContact) {
+  BrickGrid grid;
+  // A floor of microbricks under a large box: LOD must collapse the detail.
+  SeededRandom r(10);
+  for (int x = 0; x < 60; ++x)
+    for (int y = 0; y < 60; ++y) {
+      Brick b;
+      b.position = Vec3f(x * 0.1f, y * 0.1f, 0.f);
+      b.halfSize = Vec3f(0.05f, 0.05f, 0.05f);
+      grid.placeBrick(b);
+    }
+  const QueryShape big = QueryShape::box(Vec3f(4.f, 4.f, 4.f));
+  const LocalPose pose{Vec3f(3.f, 3.f, 4.04f), Quatf::Identity()};
+  ContactParams off, on;
+  off.lodFraction = 0.f;
+  on.lodFraction = 1.f / 16;
+  std::vector<LocalContact> full, lod;
+  ContactStats sFull, sLod;
+  grid.collideLocal(big, pose, off, full, &sFull);
+  grid.collideLocal(big, pose, on, lod, &sLod);
+  EXPECT_GT(sLod.lodBoxes, 0u);
+  EXPECT_LT(sLod.bricksTested + sLod.lodBoxes, sFull.bricksTested / 4) << "LOD must do much less narrowphase";
+  ASSERT_FALSE(lod.empty());
+  float maxFull = 0, maxLod = 0;
+  for (auto& c : full) maxFull = std::max(maxFull, c.depth);
+  for (auto& c : lod) maxLod = std::max(maxLod, c.depth);
+  EXPECT_NEAR(maxLod, maxFull, 0.02f) << "a flat detailed floor collides like a solid floor";
+}
+
+TEST(BrickGrid, ConvexApproximationDetectsBoxesButNeverWedges) {
+  BrickGrid cube;
+  for (int i = 0; i < 27; ++i) {
+    Brick b;
+    b.position = Vec3f(float(i % 3), float((i / 3) % 3), float(i / 9));
+    b.halfSize = Vec3f::Constant(0.5f);
+    cube.placeBrick(b);
+  }
+  for (int depth = 0; depth < 4; ++depth) {
+    const ConvexApproximation& a = cube.convexApproximation(depth);
+    EXPECT_TRUE(a.isBox) << "depth " << depth;
+    EXPECT_NEAR(a.hullVolume, 27.0, 1e-3);
+  }
+  BrickGrid wedge;
+  Brick w;
+  w.position = Vec3f::Zero();
+  w.halfSize = Vec3f(1, 2, 3);
+  w.shape = BrickShape::Wedge;
+  wedge.placeBrick(w);
+  const ConvexApproximation& aw = wedge.convexApproximation(2);
+  EXPECT_FALSE(aw.isBox);
+  EXPECT_EQ(aw.vertices.size(), 6u);
+  EXPECT_NEAR(aw.hullVolume, 24.0, 1e-3);  // half of the 2x4x6 box
+  // An L-shape of boxes is not a box either, and its hull is larger than its volume.
+  BrickGrid ell;
+  for (int i = 0; i < 3; ++i) {
+    Brick b;
+    b.halfSize = Vec3f::Constant(0.5f);
+    b.position = i < 2 ? Vec3f(float(i), 0, 0) : Vec3f(0, 1, 0);
+    ell.placeBrick(b);
+  }
+  EXPECT_FALSE(ell.convexApproximation(3).isBox);
+  EXPECT_NEAR(ell.convexApproximation(3).hullVolume, 3.5, 1e-3);
+  // Cached until an edit.
+  const uint32_t extra = ell.placeBrick(Brick::box(Vec3f(1, 1, 0), Vec3f::Constant(0.5f)));
+  EXPECT_TRUE(ell.convexApproximation(3).isBox);
+  ell.removeBrick(extra);
+  EXPECT_FALSE(ell.convexApproximation(3).isBox);
+}
+
+TEST(BrickGrid, SmallGridRestsOnLargeGridThroughItsApproximation) {
+  BrickGrid floor, crate;
+  for (int x = 0; x < 20; ++x)
+    for (int y = 0; y < 20; ++y) floor.placeBrick(Brick::box(Vec3f(float(x), float(y), 0.f), Vec3f(0.5f, 0.5f, 0.1f)));
+  for (int i = 0; i < 8; ++i) crate.placeBrick(Brick::box(Vec3f(float(i & 1), float((i >> 1) & 1), float(i >> 2)) * 0.5f, Vec3f::Constant(0.25f)));
+  ContactScratch scratch;
+  std::vector<Contact> contacts;
+  int smaller = -1;
+  // The crate's bottom (local z = -0.25) sits 0.02 into the floor top (z = 0.1).
+  const RigidTransform cratePose{Vec3d(5, 5, 0.1 + 0.25 - 0.02), Quatf::Identity()};
+  const size_t n = collideGrids(floor, RigidTransform{}, crate, cratePose, 2, ContactParams{}, scratch, contacts, smaller);
+  EXPECT_EQ(smaller, 1);
+  ASSERT_GT(n, 0u);
+  for (const Contact& c : contacts) {
+    EXPECT_NEAR(c.normal.z(), 1.f, 1e-3f);
+    EXPECT_NEAR(c.depth, 0.02f, 2e-3f);
+  }
+  EXPECT_TRUE(crate.convexApproximation(2).isBox);
+}
+
+TEST(BrickGrid, EditsBetweenQueriesAreSeenImmediately) {
+  BrickGrid grid;
+  const uint32_t wall = grid.placeBrick(Brick::box(Vec3f(5, 0, 0), Vec3f(0.5f, 5, 5)));
+  const uint32_t back = grid.placeBrick(Brick::box(Vec3f(10, 0, 0), Vec3f(0.5f, 5, 5)));
+  const Ray ray = Ray::make(Vec3f::Zero(), Vec3f::UnitX());
+  EXPECT_EQ(grid.raycast(ray, ~0u).brick, wall);
+  grid.removeBrick(wall);
+  EXPECT_EQ(grid.raycast(ray, ~0u).brick, back);
+  EXPECT_NEAR(grid.raycast(ray, ~0u).t, 9.5f, 1e-5f);
+  std::vector<LocalContact> contacts;
+  grid.collideLocal(QueryShape::sphere(1.f), LocalPose{Vec3f(5, 0, 0), Quatf::Identity()}, ContactParams{}, contacts);
+  EXPECT_TRUE(contacts.empty()) << "a removed brick must not collide";
+}
+
+TEST(BrickGrid, BadBricksAndQueriesAreRejectedWithoutChanges) {
+  BrickGrid grid;
+  grid.placeBrick(Brick::box(Vec3f(0, 0, 0), Vec3f::Constant(0.5f)));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(grid.placeBrick(Brick::box(Vec3f(nan, 0, 0), Vec3f::Constant(0.5f))), InvalidInput);
+  EXPECT_THROW(grid.placeBrick(Brick::box(Vec3f(0, 0, 0), Vec3f(0.5f, -1.f, 0.5f))), InvalidInput);
+  EXPECT_THROW(grid.placeBrick(Brick::box(Vec3f(0, 0, 0), Vec3f(0.5f, 0.f, 0.5f))), InvalidInput);
+  EXPECT_THROW(grid.placeBrick(Brick::box(Vec3f(2e9f, 0, 0), Vec3f::Constant(0.5f))), InvalidInput);
+  Brick cyl = Brick::box(Vec3f(0, 0, 0), Vec3f::Constant(0.5f));
+  cyl.shape = BrickShape::Cylinder;
+  cyl.sides = 2;
+  EXPECT_THROW(grid.placeBrick(cyl), InvalidInput);
+  EXPECT_THROW(grid.removeBrick(77), InvalidInput);
+  EXPECT_EQ(grid.brickCount(), 1u);
+  grid.index().validate();
+  ContactScratch scratch;
+  std::vector<Contact> out;
+  RigidTransform bad;
+  bad.translation.x() = std::nan("");
+  EXPECT_THROW(grid.collide(RigidTransform{}, QueryShape::sphere(1), bad, ContactParams{}, scratch, out), InvalidInput);
+  EXPECT_THROW(grid.collide(RigidTransform{}, QueryShape::sphere(-1), RigidTransform{}, ContactParams{}, scratch, out), InvalidInput);
+  try {
+    grid.placeBrick(Brick::box(Vec3f(0, 0, 0), Vec3f(0.5f, nan, 0.5f)));
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("brick.halfSize.y"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace bw
