@@ -81,6 +81,30 @@ GridRayHit BrickGrid::raycast(const Ray& ray, uint32_t mask, QueryStats* stats) 
   return out;
 }
 
+GridSweepHit BrickGrid::sweep(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to,
+                              uint32_t mask, QueryStats* stats) const {
+  shape.validate("BrickGrid::sweep");
+  requireFinite(from, "BrickGrid::sweep", "from");
+  requireFinite(to, "BrickGrid::sweep", "to");
+  requireUnitQuaternion(rotation, "BrickGrid::sweep", "rotation");
+  const Vec3f grow = rotation.toRotationMatrix().cwiseAbs() * shape.localHalfExtents();
+  const Ray ray = Ray::make(from, to - from, 1.f);
+  GridSweepHit out;
+  const RayHit h = index_.sweepClosest(ray, grow, mask,
+                                       [&](uint32_t e, float, float tMax, float& tHit) {
+                                         float f;
+                                         Vec3f n, p;
+                                         if (!sweepShapeBrick(shape, rotation, from, to, brick(index_.payload(e)), f, n, p)) return false;
+                                         tHit = f;
+                                         return f <= tMax;
+                                       },
+                                       stats);
+  if (!h.hit()) return out;
+  out.brick = index_.payload(h.element);
+  sweepShapeBrick(shape, rotation, from, to, brick(out.brick), out.fraction, out.normal, out.point);
+  return out;
+}
+
 void BrickGrid::overlapBricks(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats) const {
   index_.overlap(box, mask, [&](uint32_t e) { out.push_back(index_.payload(e)); }, stats);
 }

@@ -40,6 +40,15 @@ struct GridRayHit {
   bool hit() const { return brick != 0xFFFFFFFFu; }
 };
 
+/// A sweep hit: first time of impact as a fraction of the motion, on the brick's real shape.
+struct GridSweepHit {
+  uint32_t brick = 0xFFFFFFFFu;
+  float fraction = 1.f;          ///< 0..1 of the motion from -> to
+  Vec3f normal = Vec3f::Zero();  ///< from the brick towards the shape
+  Vec3f point = Vec3f::Zero();   ///< on the brick
+  bool hit() const { return brick != 0xFFFFFFFFu; }
+};
+
 /// Knobs of a contact query.
 struct ContactParams {
   uint32_t mask = 0xFFFFFFFFu;    ///< filter mask against brick filter bits
@@ -110,6 +119,11 @@ class BrickGrid {
   // ---- queries (grid frame) ----
   /// Closest hit on real brick shapes.
   GridRayHit raycast(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr) const;
+  /// First time of impact of a shape (fixed rotation, grid frame) moving from `from` to `to`:
+  /// a ray traversal against bounds grown by the shape's extents, then conservative advancement
+  /// (GJK distances) against each candidate brick's real shape.
+  GridSweepHit sweep(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to, uint32_t mask,
+                     QueryStats* stats = nullptr) const;
   /// Bricks whose bounds overlap box (ids appended).
   void overlapBricks(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats = nullptr) const;
 

@@ -79,6 +79,8 @@ struct BoxBoxCollector : btDiscreteCollisionDetectorInterface::Result {
 // capsule a segment), so the gap is the core distance minus both margins; when the cores
 // overlap, Penetration works on the full shapes. Both report the normal from the brick (shape
 // 1) towards the query shape (shape 0), and witnesses[1] on the brick's core.
+// note: the witnesses come back in world space but the normal in shape 0's local frame, so it
+// is rotated by shape 0's basis here (found by a sweep test with a rotated capsule).
 int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConvexShape& brick, const btTransform& trBrick,
            uint32_t feature, uint32_t material, float margin, LocalContact* out) {
   btGjkEpaSolver2::sResults res;
@@ -87,20 +89,110 @@ int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConve
   if (btGjkEpaSolver2::Distance(&shape, trShape, &brick, trBrick, guess, res)) {
     const float gap = float(res.distance) - margins;
     if (gap >= margin) return 0;
-    const Vec3f n = fromBt(res.normal).normalized();
+    const Vec3f n = fromBt(trShape.getBasis() * res.normal).normalized();
     if (!n.allFinite()) return 0;
     const Vec3f onBrick = fromBt(res.witnesses[1]) + n * float(brick.getMargin());
     out[0] = {onBrick, n, -gap, feature, material};
     return 1;
   }
   if (!btGjkEpaSolver2::Penetration(&shape, trShape, &brick, trBrick, guess, res)) return 0;
-  Vec3f n = fromBt(res.normal);
+  Vec3f n = fromBt(trShape.getBasis() * res.normal);
   if (!n.allFinite() || n.squaredNorm() < 1e-12f) return 0;
   out[0] = {fromBt(res.witnesses[1]), n.normalized(), -float(res.distance), feature, material};
   return 1;
 }
 
 }  // namespace
+
+namespace {
+
+// Runs f(btConvexShape&) with the query shape as a Bullet shape (no allocation).
+template <class F>
+auto withBulletShape(const QueryShape& shape, F&& f) {
+  switch (shape.kind) {
+    case QueryShape::Kind::Sphere: {
+      btSphereShape s(shape.radius);
+      return f(static_cast<btConvexShape&>(s));
+    }
+    case QueryShape::Kind::Capsule: {
+      btCapsuleShapeZ s(shape.radius, 2 * shape.halfHeight);
+      return f(static_cast<btConvexShape&>(s));
+    }
+    case QueryShape::Kind::Hull: {
+      thread_local std::vector<btVector3> pts;
+      pts.resize(shape.pointCount);
+      for (uint32_t i = 0; i < shape.pointCount; ++i) pts[i] = bt(shape.points[i]);
+      btConvexPointCloudShape s(pts.data(), int(shape.pointCount), btVector3(1, 1, 1), false);
+      s.setMargin(0);
+      s.recalcLocalAabb();
+      return f(static_cast<btConvexShape&>(s));
+    }
+    default: {
+      btBoxShape s(bt(shape.halfExtents));
+      s.setMargin(0);
+      return f(static_cast<btConvexShape&>(s));
+    }
+  }
+}
+
+}  // namespace
+
+bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to, const Brick& b,
+                     float& fraction, Vec3f& normal, Vec3f& point) {
+  // A sweep that starts in penetration hits at fraction 0 (like a ray starting inside a brick).
+  LocalContact start[kMaxContactsPerBrick];
+  const int n0 = collideShapeBrick(shape, LocalPose{from, rotation}, b, 0, 0.f, start);
+  for (int i = 0; i < n0; ++i) {
+    if (start[i].depth > 1e-4f) {
+      fraction = 0.f;
+      normal = start[i].normal;
+      point = start[i].position;
+      return true;
+    }
+  }
+  btVector3 verts[kMaxBrickVertices];
+  Vec3f v[kMaxBrickVertices];
+  const int nv = canonicalBrickVertices(b, v);
+  for (int i = 0; i < nv; ++i) verts[i] = bt(v[i]);
+  btConvexPointCloudShape brick(verts, nv, btVector3(1, 1, 1), false);
+  brick.setMargin(0);
+  brick.recalcLocalAabb();
+  const btTransform trBrick = brickTransform(b);
+  const btQuaternion q(rotation.x(), rotation.y(), rotation.z(), rotation.w());
+  const Vec3f motion = to - from;
+  // Conservative advancement: for a translating convex shape the distance to a convex brick is a
+  // convex function of t, so stepping to the zero of its tangent (distance / approach speed)
+  // never passes the first contact; a few exact GJK distances converge on it.
+  // note: replaces btGjkConvexCast, which was seen to miss a hull sweeping through a cylinder.
+  return withBulletShape(shape, [&](btConvexShape& s) {
+    const float margins = float(s.getMargin() + brick.getMargin());
+    const float tolerance = 1e-4f * (1.f + b.halfSize.maxCoeff());
+    float t = 0.f;
+    for (int it = 0; it < 64; ++it) {
+      const btTransform trShape(q, bt(from + motion * t));
+      btGjkEpaSolver2::sResults res;
+      if (!btGjkEpaSolver2::Distance(&s, trShape, &brick, trBrick, trShape.getOrigin() - trBrick.getOrigin(), res)) {
+        fraction = t;  // cores touch: within the tolerance of the previous step
+        normal = -motion.normalized();
+        point = from + motion * t;
+        return true;
+      }
+      const float gap = float(res.distance) - margins;
+      const Vec3f n = fromBt(trShape.getBasis() * res.normal).normalized();
+      if (gap <= tolerance) {
+        fraction = t;
+        normal = n;
+        point = fromBt(res.witnesses[1]) + n * float(brick.getMargin());
+        return true;
+      }
+      const float approach = -n.dot(motion);
+      if (!(approach > 0.f)) return false;  // moving away from (or along) the brick
+      t += gap / approach;
+      if (t > 1.f) return false;
+    }
+    return false;
+  });
+}
 
 int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
                       float speculativeMargin, LocalContact* out) {

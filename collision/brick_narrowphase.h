@@ -35,6 +35,14 @@ constexpr int kMaxContactsPerBrick = 4;
 int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
                       float speculativeMargin, LocalContact* out);
 
+/// Time of impact of shape (rotation fixed) moving from `from` to `to` against brick b, as a
+/// fraction in [0, 1] of the motion, with the normal (from the brick towards the shape) and the
+/// contact point on the brick at impact, by conservative advancement on Bullet's exact GJK distance;
+/// a shape already penetrating
+/// the brick at `from` hits at fraction 0. False when it never touches.
+bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to, const Brick& b,
+                     float& fraction, Vec3f& normal, Vec3f& point);
+
 /// Reduces n contacts to at most maxOut in place (deepest first, then the points that span the
 /// largest area). Returns the new count. Deterministic for a given input order.
 int reduceManifold(LocalContact* contacts, int n, int maxOut);

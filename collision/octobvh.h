@@ -106,6 +106,12 @@ class OctoBvh {
   template <class Exact = AabbRayExact>
   RayHit raycastClosest(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr, Exact&& exact = {},
                         RayChildOrder order = RayChildOrder::FrontToBack) const;
+  /// Sweep of a shape whose bounds have the given half extents along the ray (t in ray units):
+  /// traversal against bounds grown by the extents; exact(handle, tEnterGrownBox, tMax, tHit)
+  /// gives the shape's real time of impact.
+  template <class Exact>
+  RayHit sweepClosest(const Ray& ray, const Vec3f& halfExtents, uint32_t mask, Exact&& exact,
+                      QueryStats* stats = nullptr) const;
   /// Some hit (the first found), or none.
   template <class Exact = AabbRayExact>
   RayHit raycastAny(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr, Exact&& exact = {}) const;

@@ -214,16 +214,19 @@ namespace octobvh_detail {
 /// Shared ray traversal: calls onElement(e, tEnterBox) for elements whose bounds the ray enters
 /// before the current limit; onElement returns the new limit (pruning farther nodes) and may
 /// set `stop` to end the traversal.
+/// `grow` expands every node and element box before the ray test: a sweep of a shape whose
+/// bounds have half extents `grow` is a ray against the grown boxes (article 000, "Sweep Query").
 template <class Tree, class OnElement>
 void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::array<uint8_t, 8>& order, float& limit,
-                 bool& stop, uint64_t& tests, uint64_t& elementTests, OnElement&& onElement) {
+                 bool& stop, uint64_t& tests, uint64_t& elementTests, OnElement&& onElement,
+                 const Vec3f& grow = Vec3f::Zero()) {
   using namespace octobvh;
   const uint32_t rootC = tree.rootCluster();
   const NodeCluster& root = tree.cluster(rootC);
   if (!(root.filter[0] & mask)) return;
   ++tests;
   float t;
-  if (!intersectRayAabb(ray, root.bounds(0), 0.f, limit, t)) return;
+  if (!intersectRayAabb(ray, root.bounds(0).expanded(grow), 0.f, limit, t)) return;
   RayEntry stack[kStackSize];
   int sp = 0;
   stack[sp++] = {nodeRef(rootC, 0), t};
@@ -239,7 +242,7 @@ void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::arr
       ++tests;
       ++elementTests;
       float te;
-      if (intersectRayAabb(ray, r.bounds(), 0.f, limit, te)) limit = onElement(e, te, stop);
+      if (intersectRayAabb(ray, r.bounds().expanded(grow), 0.f, limit, te)) limit = onElement(e, te, stop);
     });
     if (cl.child[s] == kNone) continue;
     const uint32_t c = cl.child[s];
@@ -250,7 +253,7 @@ void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::arr
       if (!(ch.filter[o] & mask)) continue;
       ++tests;
       float tc;
-      if (intersectRayAabb(ray, ch.bounds(o), 0.f, limit, tc)) stack[sp++] = {nodeRef(c, o), tc};
+      if (intersectRayAabb(ray, ch.bounds(o).expanded(grow), 0.f, limit, tc)) stack[sp++] = {nodeRef(c, o), tc};
     }
   }
 }
@@ -273,6 +276,28 @@ RayHit OctoBvh::raycastClosest(const Ray& ray, uint32_t mask, QueryStats* stats,
                                   best = {e, th};
                                 return best.hit() ? best.t : limit;
                               });
+  if (stats) {
+    stats->boxTests += tests;
+    stats->elementTests += elementTests;
+  }
+  return best;
+}
+
+template <class Exact>
+RayHit OctoBvh::sweepClosest(const Ray& ray, const Vec3f& halfExtents, uint32_t mask, Exact&& exact,
+                             QueryStats* stats) const {
+  RayHit best{RayHit().element, ray.maxT};
+  float limit = ray.maxT;
+  bool stop = false;
+  uint64_t tests = 0, elementTests = 0;
+  octobvh_detail::traverseRay(
+      *this, ray, mask, rayChildOrder(ray.dir), limit, stop, tests, elementTests,
+      [&](uint32_t e, float tBox, bool&) {
+        float th;
+        if (exact(e, tBox, limit, th) && th <= limit && (th < best.t || (th == best.t && e < best.element))) best = {e, th};
+        return best.hit() ? best.t : limit;
+      },
+      halfExtents);
   if (stats) {
     stats->boxTests += tests;
     stats->elementTests += elementTests;

@@ -397,3 +397,87 @@ TEST(BrickGrid, BadBricksAndQueriesAreRejectedWithoutChanges) {
 
 }  // namespace
 }  // namespace bw
+
+namespace bw {
+namespace {
+
+TEST(BrickGrid, SweepsMatchBruteForceAndStopAtFirstTouch) {
+  BrickGrid grid;
+  for (const Brick& b : randomBuild(11, 2500, Vec3f::Zero())) grid.placeBrick(b);
+  SeededRandom r(12);
+  std::vector<Vec3f> hull;
+  int hits = 0;
+  for (int q = 0; q < 120; ++q) {
+    const QueryShape shape = shapeFor(q, hull);
+    const Quatf rot(Eigen::AngleAxisf(float(r.uniform(0, 6.28)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized()));
+    const Vec3f from(float(r.uniform(-6, 30)), float(r.uniform(-6, 30)), float(r.uniform(-6, 30)));
+    Vec3f to = from + Vec3f(float(r.normal()), float(r.normal()), float(r.normal())) * 12.f;
+    if (q % 5 == 0) to = from + Vec3f(0, 0, -15.f);  // axis-aligned sweeps
+    float best = 2.f;
+    grid.forEachBrick([&](uint32_t id) {
+      float f;
+      Vec3f n, p;
+      if (sweepShapeBrick(shape, rot, from, to, grid.brick(id), f, n, p)) best = std::min(best, f);
+    });
+    const GridSweepHit h = grid.sweep(shape, rot, from, to, ~0u);
+    ASSERT_EQ(h.hit(), best <= 1.f) << "sweep " << q;
+    if (!h.hit()) continue;
+    ++hits;
+    ASSERT_EQ(h.fraction, best) << "sweep " << q;
+    if (h.fraction > 0.f) {
+      ASSERT_LE(h.normal.dot(to - from), 1e-4f) << "an impact normal opposes the motion, sweep " << q;
+    }
+    std::vector<LocalContact> contacts;
+    ContactParams p;
+    p.lodFraction = 0.f;
+    if (h.fraction == 0.f) {
+      // Starting in contact: the start pose touches or penetrates the reported brick.
+      ContactParams touching = p;
+      touching.speculativeMargin = 1e-3f;
+      grid.collideLocal(shape, LocalPose{from, rot}, touching, contacts);
+      ASSERT_TRUE(std::any_of(contacts.begin(), contacts.end(), [&](const LocalContact& c) { return c.feature == h.brick && c.depth > -1e-3f; }))
+          << "sweep " << q;
+      continue;
+    }
+    // Just before the impact the shape does not penetrate anything.
+    grid.collideLocal(shape, LocalPose{from + (to - from) * std::max(0.f, h.fraction - 0.02f), rot}, p, contacts);
+    for (const LocalContact& c : contacts) {
+      ASSERT_LT(c.depth, 1e-3f) << "sweep " << q << " tunnels into brick " << c.feature;
+    }
+  }
+  EXPECT_GT(hits, 30);
+}
+
+}  // namespace
+}  // namespace bw
+
+namespace bw {
+namespace {
+
+// A rotated query shape must get the same world normal as the unrotated one when its geometry
+// is symmetric (sphere, capsule spun about its axis), and normals must point out of the brick.
+TEST(BrickNarrowphase, NormalsDoNotDependOnTheShapeRotation) {
+  SeededRandom r(13);
+  Brick b = Brick::box(Vec3f::Zero(), Vec3f(1.f, 2.f, 0.5f));
+  for (int k = 0; k < 500; ++k) {
+    b.shape = BrickShape(k % 4);
+    b.rotation = AxisRotation::fromIndex(int(r.below(24)));
+    const Vec3f pos(float(r.uniform(-2, 2)), float(r.uniform(-3, 3)), float(r.uniform(-2, 2)));
+    const Quatf spin(Eigen::AngleAxisf(float(r.uniform(0, 6.28)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized()));
+    LocalContact a[4], c[4];
+    const int na = collideShapeBrick(QueryShape::sphere(0.6f), LocalPose{pos, Quatf::Identity()}, b, 0, 1.f, a);
+    const int nc = collideShapeBrick(QueryShape::sphere(0.6f), LocalPose{pos, spin}, b, 0, 1.f, c);
+    ASSERT_EQ(na, nc);
+    for (int i = 0; i < na; ++i) {
+      ASSERT_LT((a[i].normal - c[i].normal).norm(), 2e-3f) << "case " << k;
+      ASSERT_NEAR(a[i].depth, c[i].depth, 1e-4f);
+      // A sphere centred outside the brick lies on the normal's side of the contact point.
+      if (!brickContains(b, pos)) {
+        ASSERT_GT((pos - a[i].position).dot(a[i].normal), -1e-3f) << "case " << k;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace bw
