@@ -31,12 +31,12 @@ struct SmallList {
 // ---------------------------------------------------------------- cubes
 
 int OctoBvh::Cube::childSlotFor(const double c[3]) const {
-  const double half = std::ldexp(1.0, level - 1);
+  const double half = pow2(level - 1);
   return (c[0] >= origin[0] + half ? 1 : 0) | (c[1] >= origin[1] + half ? 2 : 0) | (c[2] >= origin[2] + half ? 4 : 0);
 }
 
 OctoBvh::Cube OctoBvh::Cube::child(int slot) const {
-  const double half = std::ldexp(1.0, level - 1);
+  const double half = pow2(level - 1);
   return {{origin[0] + ((slot & 1) ? half : 0.0), origin[1] + ((slot & 2) ? half : 0.0),
            origin[2] + ((slot & 4) ? half : 0.0)},
           level - 1};
@@ -249,7 +249,7 @@ void OctoBvh::clearNode(uint32_t c, int s) {
   cl.maxMinLevel[s] = kEmptyMinLevel;
 }
 
-void OctoBvh::refit(uint32_t c, int s) {
+bool OctoBvh::refit(uint32_t c, int s) {
   NodeCluster& cl = clusters_[c];
   Aabb b = Aabb::empty();
   uint32_t filter = 0;
@@ -269,9 +269,11 @@ void OctoBvh::refit(uint32_t c, int s) {
       mml = std::max<int>(mml, ch.maxMinLevel[o]);
     }
   }
+  const bool changed = !(cl.bounds(s) == b) || cl.filter[s] != filter || cl.maxMinLevel[s] != mml;
   cl.setBounds(s, b);
   cl.filter[s] = filter;
   cl.maxMinLevel[s] = int8_t(mml);
+  return changed;
 }
 
 void OctoBvh::makeLeaf(uint32_t c, int s, const uint32_t* elems, uint32_t count) {
@@ -420,7 +422,7 @@ uint32_t OctoBvh::insert(const Aabb& bounds, uint32_t filter, uint32_t payload) 
 void OctoBvh::growRootToHold(const double c[3], int minLevel) {
   for (;;) {
     const int R = rootLevel_ - 1;
-    const double half = std::ldexp(1.0, R);
+    const double half = pow2(R);
     bool inside = minLevel <= R;
     for (int i = 0; i < 3; ++i) inside = inside && c[i] >= -half && c[i] < half;
     if (inside) return;
@@ -560,21 +562,22 @@ void OctoBvh::update(uint32_t handle, const Aabb& bounds, uint32_t filter) {
   insertAt(rootCluster_, 0, rootCube(), handle);
 }
 
-void OctoBvh::removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e) {
+bool OctoBvh::removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e) {
   const uint32_t child = clusters_[c].child[s];
   --clusters_[child].childTotal;
   double ctr[3];
   centreOf(elements_[e], ctr);
   const int o = cube.childSlotFor(ctr);
-  removeAt(child, o, cube.child(o), e);
+  return removeAt(child, o, cube.child(o), e);
 }
 
-void OctoBvh::removeAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
+// Returns whether the node's summary (bounds, filter OR, max min level) changed, so callers
+// above can skip their refit when it did not (most removals change only the bottom levels).
+bool OctoBvh::removeAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
   NodeCluster& cl = clusters_[c];
   if (cl.child[s] == kNone) {
     heldRemove(c, s, e);
-    refit(c, s);
-    return;
+    return refit(c, s);
   }
   const uint32_t child = cl.child[s];
   NodeCluster& ch = clusters_[child];
@@ -589,14 +592,15 @@ void OctoBvh::removeAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
     rest.erase(std::find(rest.begin(), rest.end(), e));
     freeSubtreeClusters(child);
     clusters_[c].child[s] = kNone;
-    makeLeaf(c, s, rest.data(), uint32_t(rest.size()));
-    return;
+    for (uint32_t x : rest) heldAdd(c, s, x);
+    return refit(c, s);
   }
   const int m = minLevelOf(elements_[e]);
+  bool below = true;  // whether something below may have changed this node's summary
   if (m >= cube.level) {
     if (ch.forcedCount > uint32_t(kLeafCapacity) + 1) {
       --ch.forcedCount;
-      removeFromChild(c, s, cube, e);
+      below = removeFromChild(c, s, cube, e);
     } else if (ch.forcedCount > 0) {
       // Down to 8 large elements: undo the forced split. maxMinLevel leads straight to them.
       ch.forcedCount = 0;
@@ -611,9 +615,9 @@ void OctoBvh::removeAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
       heldRemove(c, s, e);
     }
   } else {
-    removeFromChild(c, s, cube, e);
+    below = removeFromChild(c, s, cube, e);
   }
-  refit(c, s);
+  return below ? refit(c, s) : false;
 }
 
 void OctoBvh::shrinkRoot() {

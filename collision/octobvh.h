@@ -159,15 +159,15 @@ class OctoBvh {
   int canonicalRootLevel(const std::vector<uint32_t>& elems) const;
 
   void insertAt(uint32_t c, int s, const Cube& cube, uint32_t e);
-  void removeAt(uint32_t c, int s, const Cube& cube, uint32_t e);
+  bool removeAt(uint32_t c, int s, const Cube& cube, uint32_t e);
   void passToChild(uint32_t c, int s, const Cube& cube, uint32_t e);
-  void removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e);
+  bool removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e);
   void build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32_t count);
   void makeLeaf(uint32_t c, int s, const uint32_t* elems, uint32_t count);
   void collectBig(uint32_t c, int s, int level, std::vector<uint32_t>& out) const;
   void gatherSubtree(uint32_t c, int s, std::vector<uint32_t>& out) const;
   void freeSubtreeClusters(uint32_t cluster);
-  void refit(uint32_t c, int s);
+  bool refit(uint32_t c, int s);
   void clearNode(uint32_t c, int s);
   uint32_t allocCluster(int level);
 

@@ -88,6 +88,15 @@ inline void centreOf(const ElementRecord& r, double c[3]) {
   for (int i = 0; i < 3; ++i) c[i] = (double(r.min[i]) + double(r.max[i])) * 0.5;
 }
 
+/// 2^k as a double, exactly, for the level range the tree uses (built from the exponent bits;
+/// std::ldexp is a library call on the hot edit path).
+inline double pow2(int k) {
+  const uint64_t bits = uint64_t(k + 1023) << 52;
+  double d;
+  std::memcpy(&d, &bits, 8);
+  return d;
+}
+
 /// A node reference: cluster index << 3 | slot.
 inline uint32_t nodeRef(uint32_t cluster, int slot) { return cluster << 3 | uint32_t(slot); }
 
