@@ -6,11 +6,102 @@
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "collision/input_validation.h"
 
 namespace bw {
+
+#if defined(__SANITIZE_THREAD__)
+// note: Debian's oneTBB is not built with ThreadSanitizer, so TSan cannot see the
+// synchronisation inside its task scheduler and reports races in TBB's own range splitting.
+// Under TSan the same fixed-chunk parallelFor runs on a small std::thread pool whose
+// synchronisation TSan understands, so races in *our* job bodies stay visible.
+#define BW_JOBS_STD_THREAD_POOL 1
+#endif
+
+#if BW_JOBS_STD_THREAD_POOL
+
+struct JobSystem::Impl {
+  explicit Impl(int threads) {
+    for (int i = 1; i < threads; ++i) workers.emplace_back([this] { workerLoop(); });
+  }
+  ~Impl() {
+    {
+      std::lock_guard<std::mutex> lock(m);
+      stop = true;
+    }
+    wake.notify_all();
+    for (auto& w : workers) w.join();
+  }
+  void workerLoop() {
+    uint64_t seen = 0;
+    for (;;) {
+      {
+        std::unique_lock<std::mutex> lock(m);
+        wake.wait(lock, [&] { return stop || generation != seen; });
+        if (stop) return;
+        seen = generation;
+      }
+      runChunks();
+    }
+  }
+  void runChunks() {
+    for (uint32_t c; (c = next.fetch_add(1)) < count;) (*task)(c);
+    std::lock_guard<std::mutex> lock(m);
+    if (++finished == workers.size() + 1) done.notify_all();
+  }
+  void parallel(uint32_t chunks, const std::function<void(uint32_t)>& body) {
+    {
+      std::lock_guard<std::mutex> lock(m);
+      task = &body;
+      count = chunks;
+      next = 0;
+      finished = 0;
+      ++generation;
+    }
+    wake.notify_all();
+    runChunks();
+    std::unique_lock<std::mutex> lock(m);
+    done.wait(lock, [&] { return finished == workers.size() + 1; });
+  }
+
+  std::vector<std::thread> workers;
+  std::mutex m;
+  std::condition_variable wake, done;
+  uint64_t generation = 0;
+  bool stop = false;
+  const std::function<void(uint32_t)>* task = nullptr;
+  std::atomic<uint32_t> next{0};
+  uint32_t count = 0;
+  size_t finished = 0;
+};
+
+JobSystem::JobSystem(int threads) : threads_(threads) {
+  if (threads < 1 || threads > 1024)
+    throw InvalidInput("JobSystem: thread count is " + std::to_string(threads) + ", expected 1..1024");
+  impl_ = std::make_unique<Impl>(threads);
+}
+
+JobSystem::~JobSystem() = default;
+
+void JobSystem::parallelFor(uint32_t begin, uint32_t end, uint32_t grain,
+                            const std::function<void(uint32_t, uint32_t)>& body) {
+  if (end <= begin) return;
+  if (grain == 0) grain = 1;
+  const uint32_t chunks = chunkCount(begin, end, grain);
+  impl_->parallel(chunks, [&](uint32_t c) { body(begin + c * grain, std::min(end, begin + (c + 1) * grain)); });
+}
+
+void JobSystem::run(const std::function<void()>& f) { f(); }
+
+#else
 
 struct JobSystem::Impl {
   // note: global_control lifts TBB's default cap (the core count) so a 16-thread run on a
@@ -50,8 +141,8 @@ void JobSystem::parallelFor(uint32_t begin, uint32_t end, uint32_t grain,
   });
 }
 
-void JobSystem::run(const std::function<void()>& f) {
-  impl_->arena.execute(f);
-}
+void JobSystem::run(const std::function<void()>& f) { impl_->arena.execute(f); }
+
+#endif
 
 }  // namespace bw

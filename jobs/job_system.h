@@ -8,6 +8,8 @@
 /// range and the grain (never on the thread count or on timing), so a stage that writes one
 /// output slot per item, or one partial result per chunk merged in chunk order, gives
 /// bit-identical results for any thread count.
+/// Backend: oneTBB (task_arena + parallel_for); in ThreadSanitizer builds a std::thread pool
+/// with the same chunking, because TSan cannot see inside Debian's uninstrumented oneTBB.
 /// Thread safety: a JobSystem may be used from one controlling thread at a time. It sets
 /// oneTBB's process-wide parallelism limit while it lives, so keep one JobSystem per process
 /// (or nest only equal thread counts): TBB applies the smallest limit of all live ones.

@@ -1,0 +1,111 @@
+#pragma once
+/// Profiling zones for the frame's job graph, written as a Chrome trace (JSON trace events,
+/// opens in Perfetto or chrome://tracing), and the work/span figures of a frame.
+///
+///   bw::Profiler prof;
+///   prof.beginFrame(frameIndex);
+///   { bw::ProfileZone z(prof, "contacts", /*stage*/ 2); ... }   // on any thread
+///   prof.endFrame();
+///   prof.writeChromeTrace("frame.json");
+///   bw::WorkSpan ws = prof.workSpan(frameIndex);
+///
+/// Each thread records into its own buffer (found through a thread_local slot registered once
+/// per thread and profiler), so recording is a clock read and a vector append with no shared
+/// atomics or locks on the hot path. Buffers are merged when read.
+/// Thread safety: zones may be recorded from any thread between beginFrame and endFrame; the
+/// reading functions (events, writeChromeTrace, workSpan) need all zones of the frame closed.
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace bw {
+
+/// One closed zone.
+struct ProfileEvent {
+  const char* name;     ///< static string
+  int64_t beginNs;      ///< since the profiler's epoch
+  int64_t endNs;
+  uint32_t thread;      ///< dense thread index (registration order)
+  int32_t stage;        ///< frame stage, or -1 for zones outside the stage structure
+  uint32_t frame;
+};
+
+/// Work and span of one frame, from its job zones (those with stage >= 0).
+/// Stages run one after another; jobs inside a stage are independent. So the frame's critical
+/// path is the sum over stages of their longest job, and with p threads a stage takes at least
+/// max(work / p, longest job): the speedup bound at p threads is work / sum of those.
+struct WorkSpan {
+  double workMs = 0;           ///< sum of all job durations
+  double spanMs = 0;           ///< sum over stages of the longest job
+  int stages = 0;
+  double boundMs(int threads) const;       ///< lower bound on the frame time with p threads
+  double speedupBound(int threads) const;  ///< workMs / boundMs(p)
+  std::vector<double> stageWorkMs, stageSpanMs;
+};
+
+class Profiler {
+ public:
+  Profiler();
+  ~Profiler();
+  Profiler(const Profiler&) = delete;
+  Profiler& operator=(const Profiler&) = delete;
+
+  /// Recording is on by default; off makes zones cost one branch.
+  void setEnabled(bool on) { enabled_ = on; }
+  bool enabled() const { return enabled_; }
+
+  void beginFrame(uint32_t frame) { frame_ = frame; }
+  void endFrame() {}
+  uint32_t frame() const { return frame_; }
+
+  /// Nanoseconds since this profiler was created (steady clock).
+  int64_t now() const {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - epoch_).count();
+  }
+  /// Appends a closed zone from the calling thread.
+  void record(const char* name, int64_t beginNs, int64_t endNs, int32_t stage);
+
+  /// All recorded events, sorted by (begin, thread, end).
+  std::vector<ProfileEvent> events() const;
+  /// Work/span of one frame's job zones.
+  WorkSpan workSpan(uint32_t frame) const;
+  /// Writes every event as Chrome trace JSON ("X" complete events, microseconds). Throws
+  /// std::runtime_error naming the path if the file cannot be written.
+  void writeChromeTrace(const std::string& path) const;
+  /// Drops every recorded event (buffers keep their capacity).
+  void clear();
+
+ private:
+  struct ThreadBuffer;
+  ThreadBuffer& bufferForThisThread();
+
+  std::chrono::steady_clock::time_point epoch_;
+  bool enabled_ = true;
+  uint32_t frame_ = 0;
+  uint64_t id_;                                        // distinguishes profilers in thread slots
+  mutable std::mutex registry_;                        // taken once per thread, and by readers
+  std::vector<std::unique_ptr<ThreadBuffer>> buffers_;
+};
+
+/// RAII zone: records [construction, destruction) on the current thread.
+class ProfileZone {
+ public:
+  ProfileZone(Profiler& p, const char* name, int32_t stage = -1)
+      : p_(p), name_(name), stage_(stage), begin_(p.enabled() ? p.now() : 0) {}
+  ~ProfileZone() {
+    if (p_.enabled()) p_.record(name_, begin_, p_.now(), stage_);
+  }
+  ProfileZone(const ProfileZone&) = delete;
+  ProfileZone& operator=(const ProfileZone&) = delete;
+
+ private:
+  Profiler& p_;
+  const char* name_;
+  int32_t stage_;
+  int64_t begin_;
+};
+
+}  // namespace bw

@@ -1,0 +1,92 @@
+// Profiler: work/span figures, per-thread recording, Chrome trace output.
+#include "jobs/profiler.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "jobs/job_system.h"
+
+namespace bw {
+namespace {
+
+thread_local double benchmarkSink;  // keeps the busy loops from being optimised away
+
+TEST(Profiler, WorkSpanAndSpeedupBoundsFromStageStructure) {
+  Profiler p;
+  p.beginFrame(3);
+  const int64_t ms = 1'000'000;
+  // Stage 0: four independent 2 ms jobs. Stage 1: one 1 ms job. A zone outside the stages.
+  for (int i = 0; i < 4; ++i) p.record("job", i * 2 * ms, (i + 1) * 2 * ms, 0);
+  p.record("serial", 8 * ms, 9 * ms, 1);
+  p.record("frame", 0, 9 * ms, -1);
+  const WorkSpan ws = p.workSpan(3);
+  EXPECT_EQ(ws.stages, 2);
+  EXPECT_DOUBLE_EQ(ws.workMs, 9.0);
+  EXPECT_DOUBLE_EQ(ws.spanMs, 3.0);
+  EXPECT_DOUBLE_EQ(ws.boundMs(1), 9.0);
+  EXPECT_DOUBLE_EQ(ws.boundMs(2), 4.0 + 1.0);
+  EXPECT_DOUBLE_EQ(ws.boundMs(16), 2.0 + 1.0);
+  EXPECT_DOUBLE_EQ(ws.speedupBound(16), 3.0);
+  EXPECT_EQ(p.workSpan(4).workMs, 0.0) << "other frames are separate";
+}
+
+TEST(Profiler, ZonesFromManyThreadsGoToATraceThatParses) {
+  Profiler p;
+  JobSystem jobs(4);
+  p.beginFrame(0);
+  {
+    ProfileZone frame(p, "frame");
+    jobs.parallelFor(0, 1000, 1, [&](uint32_t b, uint32_t) {
+      ProfileZone z(p, "chunk", 0);
+      double x = 0;
+      for (int i = 0; i < 200 + int(b % 7) * 50; ++i) x += std::sqrt(double(i));
+      benchmarkSink = x;
+    });
+  }
+  p.endFrame();
+  const auto ev = p.events();
+  ASSERT_EQ(ev.size(), 1001u);
+  std::set<uint32_t> threads;
+  for (const ProfileEvent& e : ev) {
+    EXPECT_LE(e.beginNs, e.endNs);
+    threads.insert(e.thread);
+  }
+  EXPECT_LE(threads.size(), 5u);
+  const WorkSpan ws = p.workSpan(0);
+  EXPECT_GT(ws.workMs, 0.0);
+  EXPECT_LE(ws.spanMs, ws.workMs);
+  EXPECT_GE(ws.speedupBound(16), ws.speedupBound(2));
+
+  const std::string path = ::testing::TempDir() + "bw_profiler_trace.json";
+  p.writeChromeTrace(path);
+  std::ifstream in(path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["traceEvents"].size(), 1001u);
+  EXPECT_EQ(j["traceEvents"][0]["ph"], "X");
+  std::remove(path.c_str());
+  p.clear();
+  EXPECT_TRUE(p.events().empty());
+  EXPECT_THROW(p.writeChromeTrace("/nonexistent-dir/x/trace.json"), std::runtime_error);
+}
+
+TEST(Profiler, OneThreadAlternatingBetweenProfilersKeepsOneBufferEach) {
+  Profiler a, b;
+  for (int i = 0; i < 10; ++i) {
+    a.record("a", i, i + 1, 0);
+    b.record("b", i, i + 1, 0);
+  }
+  std::set<uint32_t> ta, tb;
+  for (const auto& e : a.events()) ta.insert(e.thread);
+  for (const auto& e : b.events()) tb.insert(e.thread);
+  EXPECT_EQ(a.events().size(), 10u);
+  EXPECT_EQ(ta.size(), 1u);
+  EXPECT_EQ(tb.size(), 1u);
+}
+
+}  // namespace
+}  // namespace bw
