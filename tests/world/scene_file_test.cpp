@@ -1,0 +1,126 @@
+// Scene files: a valid scene parses completely; every kind of bad value fails with a message
+// naming the file, the field and what was expected; the shipped scenes all parse.
+#include "world/scene_file.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace bw {
+namespace {
+
+const char* kValid = R"({
+  "name": "test",
+  "settings": {"gravity": [0, 0, -9.81], "timestep": 0.01, "substeps": 2, "solver_iterations": 10,
+               "frames": 50, "lod_fraction": 0.125, "approximation_depth": 2, "sleeping": false},
+  "grids": [
+    {"name": "floor", "generator": "city_block", "scale": 0.01, "seed": 3},
+    {"name": "crate", "bricks": [{"position": [0, 0, 0], "half_size": [0.25, 0.25, 0.25]},
+                                 {"position": [0, 0, 0.5], "half_size": [0.25, 0.25, 0.25], "shape": "wedge", "rotation": 5}],
+     "position": [1e6, 2, 3], "rotation": [1, 0, 0, 0], "motion": "kinematic", "angular_velocity": [0, 0, 0.5]}
+  ],
+  "spawners": [
+    {"shape": "box", "count": 100, "half_extents": [0.25, 0.25, 0.25], "region": {"min": [0, 0, 5], "max": [10, 10, 20]}},
+    {"shape": "grid", "grid": "crate", "count": 3, "region": {"min": [0, 0, 0], "max": [1, 1, 1]}, "velocity": [0, 0, -3], "seed": 9}
+  ]
+})";
+
+TEST(SceneFile, ValidSceneParsesEveryField) {
+  const SceneDescription s = parseScene(kValid, "test.json");
+  EXPECT_EQ(s.name, "test");
+  EXPECT_EQ(s.settings.substeps, 2);
+  EXPECT_EQ(s.settings.frames, 50u);
+  EXPECT_FALSE(s.settings.sleeping);
+  EXPECT_FLOAT_EQ(s.settings.lodFraction, 0.125f);
+  ASSERT_EQ(s.grids.size(), 2u);
+  EXPECT_EQ(s.grids[0].generator, "city_block");
+  EXPECT_EQ(s.grids[0].seed, 3u);
+  EXPECT_EQ(s.grids[1].bricks.size(), 2u);
+  EXPECT_EQ(s.grids[1].bricks[1].shape, BrickShape::Wedge);
+  EXPECT_EQ(s.grids[1].bricks[1].rotation.index(), 5);
+  EXPECT_EQ(s.grids[1].position.x(), 1e6);
+  EXPECT_EQ(s.grids[1].motion, MotionType::Kinematic);
+  EXPECT_FLOAT_EQ(s.grids[1].kinematic.angularVelocity.z(), 0.5f);
+  ASSERT_EQ(s.spawners.size(), 2u);
+  EXPECT_EQ(s.spawners[1].shape, SpawnerDescription::Shape::Grid);
+  EXPECT_EQ(s.spawners[1].grid, "crate");
+  EXPECT_EQ(s.spawners[1].velocity.z(), -3.0);
+}
+
+struct BadCase {
+  const char* json;
+  const char* expectedInMessage;
+};
+
+TEST(SceneFile, BadValuesNameTheFileTheFieldAndTheExpectation) {
+  const BadCase cases[] = {
+      {"{", "bad.json: not valid JSON"},
+      {R"({"grids": []})", "bad.json: scene: missing required field 'name'"},
+      {R"({"name": "x"})", "declares no grids and no spawners"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "castle"}]})", "scene.grids[0].generator: expected one of \"house\""},
+      {R"({"name": "x", "grids": [{"name": "g"}]})", "scene.grids[0]: needs exactly one of 'generator' or 'bricks'"},
+      {R"({"name": "x", "grids": [{"name": "g", "bricks": []}]})", "scene.grids[0].bricks: is empty"},
+      {R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0], "half_size": [1, 1, 1]}]}]})",
+       "scene.grids[0].bricks[0].position: expected an array of 3 numbers"},
+      {R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0, 0], "half_size": [1, -1, 1]}]}]})",
+       "scene.grids[0].bricks[0].half_size[1]: expected a number in"},
+      {R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0, 0], "half_size": [1, 1, 1], "rotation": 24}]}]})",
+       "scene.grids[0].bricks[0].rotation: expected an integer in 0..23, got 24"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house", "scale": 0}]})", "scene.grids[0].scale: expected a number in"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house", "rotation": [2, 0, 0, 0]}]})", "expected a number in"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house", "rotation": [0.5, 0, 0, 0]}]})", "expected a unit quaternion"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house", "colour": 1}]})", "scene.grids[0].colour: unknown field"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house"}, {"name": "g", "generator": "truck"}]})",
+       "scene.grids[1].name: expected a name not used by another grid"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house", "angular_velocity": [0, 0, 1]}]})", "velocities need"},
+      {R"({"name": "x", "settings": {"timestep": 0}, "grids": [{"name": "g", "generator": "house"}]})",
+       "scene.settings.timestep: expected a number in"},
+      {R"({"name": "x", "settings": {"substeps": 1.5}, "grids": [{"name": "g", "generator": "house"}]})",
+       "scene.settings.substeps: expected an integer in 1..64, got 1.5"},
+      {R"({"name": "x", "settings": {"frames": "many"}, "grids": [{"name": "g", "generator": "house"}]})",
+       "scene.settings.frames: expected an integer"},
+      {R"({"name": "x", "spawners": [{"shape": "cone", "count": 1, "region": {"min": [0,0,0], "max": [1,1,1]}}]})",
+       "scene.spawners[0].shape: expected one of \"sphere\", \"box\", \"capsule\", \"grid\""},
+      {R"({"name": "x", "spawners": [{"shape": "box", "count": -5, "region": {"min": [0,0,0], "max": [1,1,1]}}]})",
+       "scene.spawners[0].count: expected an integer in 1..1000000, got -5"},
+      {R"({"name": "x", "spawners": [{"shape": "box", "count": 1, "region": {"min": [0,0,2], "max": [1,1,1]}}]})",
+       "scene.spawners[0].region: min.z is greater than max.z"},
+      {R"({"name": "x", "spawners": [{"shape": "grid", "grid": "nope", "count": 1, "region": {"min": [0,0,0], "max": [1,1,1]}}]})",
+       "scene.spawners[0].grid: expected the name of a grid declared"},
+      {R"({"name": "x", "spawners": [{"shape": "box", "count": 1, "velocity": [1e300, 0, 0], "region": {"min": [0,0,0], "max": [1,1,1]}}]})",
+       "scene.spawners[0].velocity[0]: expected a number in"},
+  };
+  for (const BadCase& c : cases) {
+    try {
+      parseScene(c.json, "bad.json");
+      ADD_FAILURE() << "accepted: " << c.json;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expectedInMessage), std::string::npos)
+          << "message: " << e.what() << "\n expected to contain: " << c.expectedInMessage;
+      EXPECT_EQ(std::string(e.what()).rfind("bad.json", 0), 0u) << "the message starts with the file name";
+    }
+  }
+}
+
+TEST(SceneFile, MissingFileIsAClearError) {
+  try {
+    loadScene("/nonexistent/scene.json");
+    FAIL();
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.json: cannot open"), std::string::npos);
+  }
+}
+
+TEST(SceneFile, ShippedScenesParse) {
+  int n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(BW_SCENES_DIR)) {
+    if (entry.path().extension() != ".json") continue;
+    const SceneDescription s = loadScene(entry.path().string());
+    EXPECT_EQ(s.name, entry.path().stem().string()) << "scene name matches its file name";
+    ++n;
+  }
+  EXPECT_GE(n, 6);
+}
+
+}  // namespace
+}  // namespace bw

@@ -1,0 +1,266 @@
+#include "world/scene_file.h"
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "collision/build_generators.h"
+#include "collision/input_validation.h"
+
+namespace bw {
+
+namespace {
+
+using nlohmann::json;
+
+std::string describe(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  return s;
+}
+
+// A JSON value with its path in the file, for error messages.
+class Field {
+ public:
+  Field(const json& v, std::string path, const std::string& file) : v_(v), path_(std::move(path)), file_(file) {}
+
+  [[noreturn]] void fail(const std::string& expected) const {
+    throw SceneError(file_ + ": " + path_ + ": expected " + expected + ", got " + describe(v_));
+  }
+  [[noreturn]] void failMessage(const std::string& message) const { throw SceneError(file_ + ": " + path_ + ": " + message); }
+
+  bool has(const char* key) const { return v_.is_object() && v_.contains(key); }
+  Field at(const char* key) const {
+    if (!v_.is_object()) fail("an object");
+    if (!v_.contains(key)) throw SceneError(file_ + ": " + path_ + ": missing required field '" + key + "'");
+    return Field(v_.at(key), path_ + "." + key, file_);
+  }
+  Field index(size_t i) const { return Field(v_.at(i), path_ + "[" + std::to_string(i) + "]", file_); }
+  size_t arraySize(size_t maxSize) const {
+    if (!v_.is_array()) fail("an array");
+    if (v_.size() > maxSize) failMessage("has " + std::to_string(v_.size()) + " entries, at most " + std::to_string(maxSize) + " allowed");
+    return v_.size();
+  }
+  // Unknown keys are errors: a typo must not silently fall back to a default.
+  void allowOnly(std::initializer_list<const char*> keys) const {
+    if (!v_.is_object()) fail("an object");
+    std::set<std::string> allowed(keys.begin(), keys.end());
+    for (auto it = v_.begin(); it != v_.end(); ++it) {
+      if (!allowed.count(it.key())) {
+        std::string list;
+        for (const char* k : keys) list += std::string(list.empty() ? "" : ", ") + k;
+        throw SceneError(file_ + ": " + path_ + "." + it.key() + ": unknown field (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  double number(double lo, double hi) const {
+    if (!v_.is_number()) fail("a number in " + range(lo, hi));
+    const double d = v_.get<double>();
+    if (!std::isfinite(d) || d < lo || d > hi) fail("a number in " + range(lo, hi));
+    return d;
+  }
+  int64_t integer(int64_t lo, int64_t hi) const {
+    if (!v_.is_number_integer()) fail("an integer in " + std::to_string(lo) + ".." + std::to_string(hi));
+    const int64_t i = v_.get<int64_t>();
+    if (i < lo || i > hi) fail("an integer in " + std::to_string(lo) + ".." + std::to_string(hi));
+    return i;
+  }
+  uint64_t seed() const {
+    if (!v_.is_number_unsigned() && !(v_.is_number_integer() && v_.get<int64_t>() >= 0)) fail("a non-negative integer seed");
+    return v_.get<uint64_t>();
+  }
+  bool boolean() const {
+    if (!v_.is_boolean()) fail("true or false");
+    return v_.get<bool>();
+  }
+  std::string string() const {
+    if (!v_.is_string()) fail("a string");
+    return v_.get<std::string>();
+  }
+  std::string oneOf(std::initializer_list<const char*> options) const {
+    std::string list;
+    for (const char* o : options) list += std::string(list.empty() ? "" : ", ") + "\"" + o + "\"";
+    if (!v_.is_string()) fail("one of " + list);
+    const std::string s = v_.get<std::string>();
+    for (const char* o : options)
+      if (s == o) return s;
+    fail("one of " + list);
+  }
+  Vec3d vec3(double lo, double hi) const {
+    if (!v_.is_array() || v_.size() != 3) fail("an array of 3 numbers in " + range(lo, hi));
+    Vec3d out;
+    for (int i = 0; i < 3; ++i) out[i] = index(size_t(i)).number(lo, hi);
+    return out;
+  }
+  // A rotation: [w, x, y, z] unit quaternion (normalised if within 1e-3 of unit length).
+  Quatf quaternion() const {
+    if (!v_.is_array() || v_.size() != 4) fail("a unit quaternion [w, x, y, z]");
+    double q[4];
+    for (int i = 0; i < 4; ++i) q[i] = index(size_t(i)).number(-1.001, 1.001);
+    const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (std::abs(n - 1.0) > 1e-3) fail("a unit quaternion [w, x, y, z] (norm " + std::to_string(n) + ")");
+    return Quatf(float(q[0] / n), float(q[1] / n), float(q[2] / n), float(q[3] / n));
+  }
+
+ private:
+  static std::string range(double lo, double hi) {
+    std::ostringstream s;
+    s << "[" << lo << ", " << hi << "]";
+    return s.str();
+  }
+  const json& v_;
+  std::string path_;
+  const std::string& file_;
+};
+
+constexpr double kMaxCoord = 1e9;      // world coordinates (double)
+constexpr double kMaxSpeed = 1e4;      // m/s accepted in scene files
+
+Brick parseBrick(const Field& f) {
+  f.allowOnly({"position", "half_size", "shape", "rotation", "material", "filter", "sides"});
+  Brick b;
+  b.position = f.at("position").vec3(-1e8, 1e8).cast<float>();
+  b.halfSize = f.at("half_size").vec3(kMinBrickHalfSize, 1e6).cast<float>();
+  if (f.has("shape")) {
+    const std::string s = f.at("shape").oneOf({"box", "wedge", "corner_wedge", "cylinder"});
+    b.shape = s == "box" ? BrickShape::Box : s == "wedge" ? BrickShape::Wedge : s == "corner_wedge" ? BrickShape::CornerWedge : BrickShape::Cylinder;
+  }
+  if (f.has("rotation")) b.rotation = AxisRotation::fromIndex(int(f.at("rotation").integer(0, 23)));
+  if (f.has("material")) b.material = uint8_t(f.at("material").integer(0, 255));
+  if (f.has("filter")) b.filter = uint32_t(f.at("filter").integer(0, 0xFFFFFFFFll));
+  if (f.has("sides")) b.sides = uint8_t(f.at("sides").integer(3, 64));
+  return b;
+}
+
+MotionType parseMotion(const Field& f) {
+  const std::string m = f.oneOf({"static", "kinematic", "dynamic"});
+  return m == "static" ? MotionType::Static : m == "kinematic" ? MotionType::Kinematic : MotionType::Dynamic;
+}
+
+GridDescription parseGrid(const Field& f) {
+  f.allowOnly({"name", "generator", "scale", "seed", "bricks", "position", "rotation", "motion", "linear_velocity", "angular_velocity"});
+  GridDescription g;
+  g.name = f.at("name").string();
+  if (g.name.empty()) f.at("name").fail("a non-empty name");
+  if (f.has("generator") == f.has("bricks")) f.failMessage("needs exactly one of 'generator' or 'bricks'");
+  if (f.has("generator")) {
+    const Field gen = f.at("generator");
+    g.generator = gen.string();
+    const auto names = buildNames();
+    if (std::find(names.begin(), names.end(), g.generator) == names.end()) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "\"" : ", \"") + n + "\"";
+      gen.fail("one of " + list);
+    }
+    if (f.has("scale")) g.scale = float(f.at("scale").number(0.001, 64));
+    if (f.has("seed")) g.seed = f.at("seed").seed();
+  } else {
+    const Field bricks = f.at("bricks");
+    const size_t n = bricks.arraySize(10'000'000);
+    if (n == 0) bricks.failMessage("is empty: a grid needs at least one brick");
+    for (size_t i = 0; i < n; ++i) g.bricks.push_back(parseBrick(bricks.index(i)));
+  }
+  if (f.has("position")) g.position = f.at("position").vec3(-kMaxCoord, kMaxCoord);
+  if (f.has("rotation")) g.rotation = f.at("rotation").quaternion();
+  if (f.has("motion")) g.motion = parseMotion(f.at("motion"));
+  if (f.has("linear_velocity") || f.has("angular_velocity")) {
+    if (g.motion != MotionType::Kinematic && g.motion != MotionType::Dynamic)
+      f.failMessage("velocities need \"motion\": \"kinematic\" or \"dynamic\"");
+    if (f.has("linear_velocity")) g.kinematic.linearVelocity = f.at("linear_velocity").vec3(-kMaxSpeed, kMaxSpeed);
+    if (f.has("angular_velocity")) g.kinematic.angularVelocity = f.at("angular_velocity").vec3(-100, 100).cast<float>();
+  }
+  return g;
+}
+
+SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescription>& grids) {
+  f.allowOnly({"shape", "grid", "count", "half_extents", "radius", "half_height", "density", "region", "velocity", "seed"});
+  SpawnerDescription s;
+  const std::string shape = f.at("shape").oneOf({"sphere", "box", "capsule", "grid"});
+  s.shape = shape == "sphere" ? SpawnerDescription::Shape::Sphere
+          : shape == "box"    ? SpawnerDescription::Shape::Box
+          : shape == "capsule" ? SpawnerDescription::Shape::Capsule
+                               : SpawnerDescription::Shape::Grid;
+  s.count = uint32_t(f.at("count").integer(1, 1'000'000));
+  if (s.shape == SpawnerDescription::Shape::Grid) {
+    const Field g = f.at("grid");
+    s.grid = g.string();
+    if (std::none_of(grids.begin(), grids.end(), [&](const GridDescription& d) { return d.name == s.grid; }))
+      g.fail("the name of a grid declared in \"grids\"");
+  }
+  if (f.has("half_extents")) s.halfExtents = f.at("half_extents").vec3(1e-3, 1e4).cast<float>();
+  if (f.has("radius")) s.radius = float(f.at("radius").number(1e-3, 1e4));
+  if (f.has("half_height")) s.halfHeight = float(f.at("half_height").number(0, 1e4));
+  if (f.has("density")) s.density = float(f.at("density").number(1e-3, 1e5));
+  const Field region = f.at("region");
+  region.allowOnly({"min", "max"});
+  s.regionMin = region.at("min").vec3(-kMaxCoord, kMaxCoord);
+  s.regionMax = region.at("max").vec3(-kMaxCoord, kMaxCoord);
+  for (int i = 0; i < 3; ++i)
+    if (s.regionMin[i] > s.regionMax[i]) region.failMessage(std::string("min.") + "xyz"[i] + " is greater than max." + "xyz"[i]);
+  if (f.has("velocity")) s.velocity = f.at("velocity").vec3(-kMaxSpeed, kMaxSpeed);
+  if (f.has("seed")) s.seed = f.at("seed").seed();
+  return s;
+}
+
+SceneSettings parseSettings(const Field& f) {
+  f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping"});
+  SceneSettings s;
+  if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-1000, 1000);
+  if (f.has("timestep")) s.timestep = f.at("timestep").number(1.0 / 10000, 1.0 / 10);
+  if (f.has("substeps")) s.substeps = int(f.at("substeps").integer(1, 64));
+  if (f.has("solver_iterations")) s.solverIterations = int(f.at("solver_iterations").integer(1, 256));
+  if (f.has("frames")) s.frames = uint32_t(f.at("frames").integer(1, 10'000'000));
+  if (f.has("lod_fraction")) s.lodFraction = float(f.at("lod_fraction").number(0, 1));
+  if (f.has("approximation_depth")) s.approximationDepth = int(f.at("approximation_depth").integer(0, 7));
+  if (f.has("sleeping")) s.sleeping = f.at("sleeping").boolean();
+  return s;
+}
+
+}  // namespace
+
+SceneDescription parseScene(const std::string& jsonText, const std::string& sourceName) {
+  json doc;
+  try {
+    doc = json::parse(jsonText);
+  } catch (const json::parse_error& e) {
+    throw SceneError(sourceName + ": not valid JSON (" + e.what() + ")");
+  }
+  const Field root(doc, "scene", sourceName);
+  root.allowOnly({"name", "description", "settings", "grids", "spawners"});
+  SceneDescription scene;
+  scene.source = sourceName;
+  scene.name = root.at("name").string();
+  if (root.has("description")) root.at("description").string();
+  if (root.has("settings")) scene.settings = parseSettings(root.at("settings"));
+  if (root.has("grids")) {
+    const Field grids = root.at("grids");
+    const size_t n = grids.arraySize(100'000);
+    std::set<std::string> names;
+    for (size_t i = 0; i < n; ++i) {
+      scene.grids.push_back(parseGrid(grids.index(i)));
+      if (!names.insert(scene.grids.back().name).second)
+        grids.index(i).at("name").fail("a name not used by another grid");
+    }
+  }
+  if (root.has("spawners")) {
+    const Field spawners = root.at("spawners");
+    const size_t n = spawners.arraySize(10'000);
+    for (size_t i = 0; i < n; ++i) scene.spawners.push_back(parseSpawner(spawners.index(i), scene.grids));
+  }
+  if (scene.grids.empty() && scene.spawners.empty()) root.failMessage("declares no grids and no spawners: nothing to simulate");
+  return scene;
+}
+
+SceneDescription loadScene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path + ": cannot open the scene file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseScene(text.str(), path);
+}
+
+}  // namespace bw
