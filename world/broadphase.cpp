@@ -1,0 +1,71 @@
+#include "world/broadphase.h"
+
+#include <algorithm>
+#include <string>
+
+#include "collision/input_validation.h"
+
+namespace bw {
+
+void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic,
+                           std::vector<BodyPair>& pairs) {
+  const uint32_t n = uint32_t(bounds.size());
+  if (isStatic.size() != bounds.size())
+    throw InvalidInput("SweepAndPrune::update: " + std::to_string(bounds.size()) + " bounds but " +
+                       std::to_string(isStatic.size()) + " static flags");
+  for (uint32_t i = 0; i < n; ++i) {
+    const std::string what = "bounds of body " + std::to_string(i);
+    requireFinite(bounds[i].min, "SweepAndPrune::update", (what + " min").c_str());
+    requireFinite(bounds[i].max, "SweepAndPrune::update", (what + " max").c_str());
+    if ((bounds[i].min.array() > bounds[i].max.array()).any())
+      throw InvalidInput("SweepAndPrune::update: " + what + " are inverted (min > max)");
+  }
+  // Sweep along the axis where the body centres spread most (fewest overlapping intervals).
+  Vec3d mean = Vec3d::Zero(), sq = Vec3d::Zero();
+  for (const WorldAabb& b : bounds) {
+    const Vec3d c = (b.min + b.max) * 0.5;
+    mean += c;
+    sq += c.cwiseProduct(c);
+  }
+  int axis = 0;
+  if (n > 0) {
+    const Vec3d var = sq / n - (mean / n).cwiseProduct(mean / n);
+    var.maxCoeff(&axis);
+  }
+  if (axis != axis_ || order_.size() != n) {
+    axis_ = axis;
+    order_.resize(n);
+    for (uint32_t i = 0; i < n; ++i) order_[i] = i;
+  }
+  // Insertion sort from last frame's order: near-linear for coherent motion. Ties break by id
+  // so the order is a pure function of the bounds.
+  auto less = [&](uint32_t a, uint32_t b) {
+    const double ma = bounds[a].min[axis_], mb = bounds[b].min[axis_];
+    return ma < mb || (ma == mb && a < b);
+  };
+  for (uint32_t i = 1; i < n; ++i) {
+    const uint32_t v = order_[i];
+    uint32_t j = i;
+    while (j > 0 && less(v, order_[j - 1])) {
+      order_[j] = order_[j - 1];
+      --j;
+    }
+    order_[j] = v;
+  }
+  pairs.clear();
+  tests_ = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t a = order_[i];
+    const double maxA = bounds[a].max[axis_];
+    for (uint32_t j = i + 1; j < n; ++j) {
+      const uint32_t b = order_[j];
+      ++tests_;
+      if (bounds[b].min[axis_] > maxA) break;  // sorted by min: nothing further can overlap
+      if (isStatic[a] && isStatic[b]) continue;
+      if (bounds[a].overlaps(bounds[b])) pairs.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+}
+
+}  // namespace bw
