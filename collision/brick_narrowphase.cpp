@@ -137,6 +137,15 @@ auto withBulletShape(const QueryShape& shape, F&& f) {
 
 }  // namespace
 
+int collideShapes(const QueryShape& a, const LocalPose& poseA, const QueryShape& b, const LocalPose& poseB,
+                  float speculativeMargin, LocalContact* out) {
+  return withBulletShape(a, [&](btConvexShape& sa) {
+    return withBulletShape(b, [&](btConvexShape& sb) {
+      return gjkEpa(sa, poseTransform(poseA), sb, poseTransform(poseB), 0, 0, speculativeMargin, out);
+    });
+  });
+}
+
 bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to, const Brick& b,
                      float& fraction, Vec3f& normal, Vec3f& point) {
   // A sweep that starts in penetration hits at fraction 0 (like a ray starting inside a brick).
@@ -198,7 +207,7 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
                       float speculativeMargin, LocalContact* out) {
   const btTransform trShape = poseTransform(pose);
   const btTransform trBrick = brickTransform(b);
-  if (shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box && speculativeMargin <= 0.f) {
+  if (shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box) {
     btBoxShape a(bt(shape.halfExtents)), c(bt(b.halfSize));
     btBoxBoxDetector det(&a, &c);
     btDiscreteCollisionDetectorInterface::ClosestPointInput in;
@@ -209,7 +218,9 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
     col.feature = feature;
     col.material = b.material;
     det.getClosestPoints(in, col, nullptr);
-    return col.count;
+    // Touching boxes keep the detector's full manifold; separated ones fall through to GJK for
+    // a speculative point when a margin is asked for.
+    if (col.count > 0 || speculativeMargin <= 0.f) return col.count;
   }
   // Brick as a zero-margin point cloud over stack vertices (no allocation).
   btVector3 verts[kMaxBrickVertices];

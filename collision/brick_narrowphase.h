@@ -2,7 +2,8 @@
 /// Narrowphase between a query shape and one brick, in the grid's local frame.
 ///
 /// Method (documented choice): box vs box-shaped brick uses Bullet's btBoxBoxDetector (up to 4
-/// points per pair, the common case on brick floors); every other pair uses Bullet's GJK/EPA
+/// points per pair, the common case on brick floors; when they are apart and a speculative
+/// margin is asked for, GJK gives the gap); every other pair uses Bullet's GJK/EPA
 /// (btGjkEpaSolver2) on the exact brick vertices (one point per pair), with zero margins so
 /// contacts are exact. A non-penetrating pair closer than `speculativeMargin` gives one contact
 /// with negative depth (the gap), for speculative contacts.
@@ -34,6 +35,11 @@ constexpr int kMaxContactsPerBrick = 4;
 /// Returns how many were added.
 int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
                       float speculativeMargin, LocalContact* out);
+
+/// Contacts between two convex query shapes (both posed in one frame), GJK/EPA with zero
+/// margins; the normal points from b towards a, the point lies on b. Returns the count (0..1).
+int collideShapes(const QueryShape& a, const LocalPose& poseA, const QueryShape& b, const LocalPose& poseB,
+                  float speculativeMargin, LocalContact* out);
 
 /// Time of impact of shape (rotation fixed) moving from `from` to `to` against brick b, as a
 /// fraction in [0, 1] of the motion, with the normal (from the brick towards the shape) and the

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "cli/command_registry.h"
+#include "cli/scene_run.h"
 #include "collision/brick_workload.h"
 #include "collision/octobvh.h"
 #include "collision/seeded_random.h"
@@ -157,19 +158,28 @@ int runOctoBvhStress(uint32_t elements, uint64_t seed, bool json) {
   return 0;
 }
 
-CommandRegistration reg{"run", "Headless stress run of a workload (default: octobvh)", [](CLI::App& cmd) {
+CommandRegistration reg{"run", "Headless stress run: a scene (file or shipped name) or the octobvh/pool workloads", [](CLI::App& cmd) {
   auto workload = std::make_shared<std::string>("octobvh");
   auto elements = std::make_shared<uint32_t>(0);
   auto seed = std::make_shared<uint64_t>(1);
   auto json = std::make_shared<bool>(false);
-  cmd.add_option("workload", *workload, "octobvh (default) or pool")->check(CLI::IsMember({"octobvh", "pool"}));
-  cmd.add_option("--elements", *elements, "element count (default 1M bricks / 10M pool slots)")
+  auto scene = std::make_shared<SceneRunOptions>();
+  cmd.add_option("workload", *workload, "a scene file or shipped scene name (crates_on_grid, ...), or octobvh (default) or pool");
+  cmd.add_option("--elements", *elements, "octobvh/pool: element count (default 1M bricks / 10M pool slots)")
       ->check(CLI::Range(1u, 1'000'000'000u));
-  cmd.add_option("--seed", *seed, "random seed");
+  cmd.add_option("--seed", *seed, "octobvh/pool: random seed");
+  cmd.add_option("--frames", scene->frames, "scene: frames to run (default: the scene's)")->check(CLI::Range(1u, 10'000'000u));
+  cmd.add_option("--threads", scene->threads, "scene: worker threads")->check(CLI::Range(1, 1024));
+  cmd.add_option("--csv", scene->csvPath, "scene: write per-frame stage times to this CSV");
+  cmd.add_option("--trace", scene->tracePath, "scene: write a Chrome trace (open in Perfetto)");
   cmd.add_flag("--json", *json, "print one JSON object");
   return [=] {
     if (*workload == "pool") return runPoolStress(*elements ? *elements : 10'000'000, *seed, *json);
-    return runOctoBvhStress(*elements ? *elements : 1'000'000, *seed, *json);
+    if (*workload == "octobvh") return runOctoBvhStress(*elements ? *elements : 1'000'000, *seed, *json);
+    SceneRunOptions o = *scene;
+    o.scene = *workload;
+    o.json = *json;
+    return runScene(o);
   };
 }};
 

@@ -1,0 +1,144 @@
+#include "cli/scene_run.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "world/scene_file.h"
+#include "world/world.h"
+
+namespace bw::cli {
+
+namespace {
+
+struct Series {
+  std::vector<double> v;
+  double quantile(double q) const {
+    if (v.empty()) return 0;
+    std::vector<double> s = v;
+    std::sort(s.begin(), s.end());
+    return s[std::min(s.size() - 1, size_t(q * double(s.size() - 1) + 0.5))];
+  }
+  double max() const { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
+};
+
+double peakResidentMiB() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;
+}
+
+}  // namespace
+
+std::string resolveScenePath(const std::string& scene) {
+  if (std::filesystem::exists(scene)) return scene;
+  const std::string shipped = std::string(BW_SOURCE_DIR) + "/profiles/scenes/" + scene + ".json";
+  if (std::filesystem::exists(shipped)) return shipped;
+  throw SceneError(scene + ": no such scene file, and no shipped scene of that name in " + BW_SOURCE_DIR + "/profiles/scenes");
+}
+
+int runScene(const SceneRunOptions& o) {
+  using Clock = std::chrono::steady_clock;
+  const std::string path = resolveScenePath(o.scene);
+  const SceneDescription scene = loadScene(path);
+  const auto tBuild = Clock::now();
+  World world(scene, o.threads);
+  const double buildMs = std::chrono::duration<double, std::milli>(Clock::now() - tBuild).count();
+  const uint32_t frames = o.frames ? o.frames : scene.settings.frames;
+
+  Series total, broad, contacts, solver, integrate;
+  uint64_t pairs = 0, contactCount = 0, boxTests = 0;
+  std::ofstream csv;
+  if (!o.csvPath.empty()) {
+    csv.open(o.csvPath);
+    if (!csv) throw std::runtime_error("cannot write " + o.csvPath);
+    csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,pairs,contacts,box_tests\n";
+  }
+  double work = 0, span = 0;
+  const auto tRun = Clock::now();
+  for (uint32_t f = 0; f < frames; ++f) {
+    world.step();
+    const StepStats& s = world.lastStats();
+    total.v.push_back(s.totalMs);
+    broad.v.push_back(s.broadphaseMs);
+    contacts.v.push_back(s.contactsMs);
+    solver.v.push_back(s.solverMs);
+    integrate.v.push_back(s.integrateMs);
+    pairs += s.pairs;
+    contactCount += s.contacts;
+    boxTests += s.boxTests;
+    if (csv) csv << f << "," << s.totalMs << "," << s.broadphaseMs << "," << s.contactsMs << "," << s.solverMs << ","
+                 << s.integrateMs << "," << s.pairs << "," << s.contacts << "," << s.boxTests << "\n";
+    if (o.progress && !o.json && frames >= 100 && (f + 1) % (frames / 10) == 0)
+      std::fprintf(stderr, "  frame %u/%u  %.2f ms\n", f + 1, frames, s.totalMs);
+  }
+  const double runS = std::chrono::duration<double>(Clock::now() - tRun).count();
+  // Work and span over the whole run (stages are sequential, each stage's work in one zone here).
+  for (uint32_t f = 0; f < frames; ++f) {
+    const WorkSpan ws = world.profiler().workSpan(f);
+    work += ws.workMs;
+    span += ws.spanMs;
+  }
+  if (!o.tracePath.empty()) world.profiler().writeChromeTrace(o.tracePath);
+
+  // Where the dynamic bodies ended up: at rest, still moving, and the lowest one (a body far
+  // below everything would have fallen through).
+  uint32_t resting = 0, moving = 0;
+  double lowest = std::numeric_limits<double>::infinity();
+  const BodyStore& bodies = world.bodies();
+  for (uint32_t i = 0; i < bodies.size(); ++i) {
+    if (bodies.motion[i] != MotionType::Dynamic) continue;
+    (bodies.linearVelocity[i].norm() < 0.05f && bodies.angularVelocity[i].norm() < 0.1f ? resting : moving)++;
+    lowest = std::min(lowest, bodies.position[i].z());
+  }
+  auto stage = [](const Series& s) { return nlohmann::json{{"median_ms", s.quantile(0.5)}, {"p95_ms", s.quantile(0.95)}, {"max_ms", s.max()}}; };
+  if (o.json) {
+    nlohmann::json j{{"scene", scene.name},
+                     {"file", path},
+                     {"threads", o.threads},
+                     {"frames", frames},
+                     {"bodies", world.bodies().size()},
+                     {"bricks", world.brickCount()},
+                     {"build_ms", buildMs},
+                     {"frame", stage(total)},
+                     {"broadphase", stage(broad)},
+                     {"contacts", stage(contacts)},
+                     {"solver", stage(solver)},
+                     {"integrate", stage(integrate)},
+                     {"pairs_per_frame", double(pairs) / frames},
+                     {"contacts_per_frame", double(contactCount) / frames},
+                     {"box_tests_per_frame", double(boxTests) / frames},
+                     {"peak_resident_mib", peakResidentMiB()},
+                     {"dynamic_resting", resting},
+                     {"dynamic_moving", moving},
+                     {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
+                     {"state_hash", world.stateHash()}};
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::printf("scene %s (%s): %u bodies, %llu bricks, built in %.0f ms; %u frames on %d thread(s) in %.2f s\n", scene.name.c_str(),
+              path.c_str(), world.bodies().size(), (unsigned long long)world.brickCount(), buildMs, frames, o.threads, runS);
+  std::printf("  %-11s %9s %9s %9s\n", "stage", "median", "p95", "max");
+  for (auto [name, s] : {std::pair<const char*, const Series*>{"frame", &total}, {"broadphase", &broad}, {"contacts", &contacts},
+                         {"solver", &solver}, {"integrate", &integrate}})
+    std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
+  std::printf("  per frame: %.0f pairs, %.0f contacts, %.0f box tests\n", double(pairs) / frames, double(contactCount) / frames,
+              double(boxTests) / frames);
+  std::printf("  dynamic bodies at the end: %u resting, %u moving, lowest at z = %.2f\n", resting, moving, std::isfinite(lowest) ? lowest : 0.0);
+  std::printf("  peak memory %.0f MiB; state hash %016llx\n", peakResidentMiB(), (unsigned long long)world.stateHash());
+  std::printf("  work %.1f ms, span %.1f ms over the run\n", work, span);
+  if (!o.csvPath.empty()) std::printf("  per-frame CSV: %s\n", o.csvPath.c_str());
+  if (!o.tracePath.empty()) std::printf("  Chrome trace: %s (open in Perfetto)\n", o.tracePath.c_str());
+  return 0;
+}
+
+}  // namespace bw::cli

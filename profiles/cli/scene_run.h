@@ -1,0 +1,24 @@
+#pragma once
+// Running a scene from the CLI (`brickworld run SCENE`): shared by the run and sweep commands.
+#include <cstdint>
+#include <string>
+
+namespace bw::cli {
+
+struct SceneRunOptions {
+  std::string scene;        ///< path, or the name of a scene in profiles/scenes
+  uint32_t frames = 0;      ///< 0: the scene's own setting
+  int threads = 1;
+  std::string csvPath;      ///< per-frame stage times
+  std::string tracePath;    ///< Chrome trace of the whole run
+  bool json = false;
+  bool progress = true;
+};
+
+/// Runs the scene and prints the report; returns the process exit code.
+int runScene(const SceneRunOptions& options);
+
+/// Resolves a scene argument to a file path (a path as given, else profiles/scenes/NAME.json).
+std::string resolveScenePath(const std::string& scene);
+
+}  // namespace bw::cli

@@ -1,0 +1,82 @@
+// World: bodies come to rest on grids at the right height, stacks stand, kinematic grids follow
+// their script, and the final state is bit-identical for 1, 2, 4 and 16 threads.
+#include "world/world.h"
+
+#include <gtest/gtest.h>
+
+#include "world/scene_file.h"
+
+namespace bw {
+namespace {
+
+TEST(World, BoxDroppedOnAGridComesToRestOnIt) {
+  const SceneDescription scene = parseScene(R"({
+    "name": "drop", "settings": {"timestep": 0.016666667, "substeps": 2, "solver_iterations": 10},
+    "grids": [{"name": "floor", "bricks": [{"position": [0, 0, -0.5], "half_size": [5, 5, 0.5]},
+                                           {"position": [12, 0, -0.5], "half_size": [5, 5, 0.5]}]}],
+    "spawners": [{"shape": "box", "count": 1, "half_extents": [0.25, 0.25, 0.25],
+                  "region": {"min": [1, 1, 3], "max": [1, 1, 3]}}]})",
+                                            "drop.json");
+  World world(scene, 1);
+  for (int f = 0; f < 240; ++f) world.step();
+  const BodyStore& b = world.bodies();
+  ASSERT_EQ(b.size(), 2u);
+  // Resting on a face: its centre 0.25 above the floor top (z = 0), within solver slop.
+  EXPECT_NEAR(b.position[1].z(), 0.25, 0.02);
+  EXPECT_LT(b.linearVelocity[1].norm(), 0.05f);
+  EXPECT_NEAR(b.position[1].x(), 1.0, 0.5);
+}
+
+TEST(World, TenBoxStackStaysStanding) {
+  World world(loadScene(std::string(BW_SCENES_DIR) + "/stack10.json"), 1);
+  for (int f = 0; f < 300; ++f) world.step();  // 5 s
+  const BodyStore& b = world.bodies();
+  for (uint32_t i = 1; i <= 10; ++i) {
+    EXPECT_NEAR(b.position[i].z(), 0.25 + 0.5 * (i - 1), 0.03) << "box " << i;
+    EXPECT_LT(std::hypot(b.position[i].x(), b.position[i].y()), 0.05) << "box " << i;
+  }
+}
+
+TEST(World, KinematicGridFollowsItsScript) {
+  const SceneDescription scene = parseScene(R"({
+    "name": "spin", "settings": {"gravity": [0, 0, 0]},
+    "grids": [{"name": "ring", "bricks": [{"position": [10, 0, 0], "half_size": [0.5, 0.5, 0.5]}],
+               "motion": "kinematic", "angular_velocity": [0, 0, 0.5], "linear_velocity": [1, 0, 0]}]})",
+                                            "spin.json");
+  World world(scene, 1);
+  for (int f = 0; f < 60; ++f) world.step();  // 1 s
+  const BodyStore& b = world.bodies();
+  EXPECT_NEAR(b.position[0].x(), 1.0, 1e-4);
+  const float angle = 2.f * std::atan2(b.rotation[0].z(), b.rotation[0].w());
+  EXPECT_NEAR(angle, 0.5f, 1e-3f);
+}
+
+TEST(World, StateIsIdenticalForAnyThreadCount) {
+  const SceneDescription scene = parseScene(R"({
+    "name": "det", "settings": {"timestep": 0.016666667, "frames": 40},
+    "grids": [{"name": "city", "generator": "city_block", "scale": 0.003, "seed": 7},
+              {"name": "crate", "bricks": [{"position": [0, 0, 0], "half_size": [0.2, 0.2, 0.2]},
+                                           {"position": [0.4, 0, 0], "half_size": [0.2, 0.2, 0.2]}],
+               "position": [0, 0, -500]}],
+    "spawners": [{"shape": "box", "count": 60, "half_extents": [0.25, 0.25, 0.25], "region": {"min": [5, 5, 55], "max": [60, 60, 62]}},
+                 {"shape": "capsule", "count": 30, "radius": 0.2, "half_height": 0.3, "region": {"min": [5, 5, 55], "max": [60, 60, 62]}},
+                 {"shape": "grid", "grid": "crate", "count": 10, "region": {"min": [5, 5, 55], "max": [60, 60, 62]}}]})",
+                                            "det.json");
+  uint64_t reference = 0;
+  for (int threads : {1, 2, 4, 16}) {
+    World world(scene, threads);
+    uint32_t contacts = 0;
+    for (int f = 0; f < 150; ++f) {
+      world.step();
+      contacts += world.lastStats().contacts;
+    }
+    if (threads == 1) {
+      reference = world.stateHash();
+      EXPECT_GT(contacts, 100u) << "the bodies must actually land and touch";
+    }
+    EXPECT_EQ(world.stateHash(), reference) << threads << " threads";
+  }
+}
+
+}  // namespace
+}  // namespace bw

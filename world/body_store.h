@@ -1,0 +1,50 @@
+#pragma once
+/// Bodies in structure-of-arrays form: one vector per field, indexed by body id.
+///
+/// A body's frame is its centre of mass with principal axes; `position`/`rotation` are that
+/// frame in the world (double position, float rotation). Its collision shape (a primitive or a
+/// brick grid) sits at `shapeFromBody` inside that frame. Static bodies have zero inverse mass;
+/// kinematic ones too, but move with their scripted velocities.
+#include <cstdint>
+#include <vector>
+
+#include "collision/query_shape.h"
+#include "collision/rigid_transform.h"
+#include "world/scene_description.h"
+
+namespace bw {
+
+/// What collides for a body: a primitive, or a brick grid (index into the world's grids).
+struct BodyShape {
+  QueryShape primitive;             ///< used when grid == kNoGrid
+  uint32_t grid = kNoGrid;
+  static constexpr uint32_t kNoGrid = 0xFFFFFFFFu;
+  bool isGrid() const { return grid != kNoGrid; }
+};
+
+struct BodyStore {
+  std::vector<Vec3d> position;            // centre of mass, world
+  std::vector<Quatf> rotation;            // principal frame, world
+  std::vector<Vec3f> linearVelocity;
+  std::vector<Vec3f> angularVelocity;     // world frame
+  std::vector<float> inverseMass;
+  std::vector<Vec3f> inverseInertia;      // principal, body frame
+  std::vector<MotionType> motion;
+  std::vector<BodyShape> shape;
+  std::vector<RigidTransform> shapeFromBody;  // shape frame expressed in the body frame
+  std::vector<float> friction;
+
+  uint32_t size() const { return uint32_t(position.size()); }
+  /// Appends a body; returns its id.
+  uint32_t add(const Vec3d& pos, const Quatf& rot, MotionType m, const BodyShape& s, float invMass, const Vec3f& invInertia,
+               const RigidTransform& shapeFrame = RigidTransform{});
+  /// World pose of the body's collision shape.
+  RigidTransform shapePose(uint32_t i) const { return RigidTransform{position[i], rotation[i]} * shapeFromBody[i]; }
+  /// World-frame inverse inertia tensor.
+  Mat3f inverseInertiaWorld(uint32_t i) const {
+    const Mat3f R = rotation[i].toRotationMatrix();
+    return R * inverseInertia[i].asDiagonal() * R.transpose();
+  }
+};
+
+}  // namespace bw

@@ -1,0 +1,406 @@
+#include "world/world.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+
+#include "collision/build_generators.h"
+#include "collision/input_validation.h"
+#include "collision/seeded_random.h"
+#include "world/scene_file.h"
+
+namespace bw {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// Solver constants (documented in README "World"): Baumgarte factor, allowed penetration,
+// restitution and the speed below which bounces are not restituted.
+constexpr float kBaumgarte = 0.2f;
+constexpr float kSlop = 0.005f;
+constexpr float kRestitution = 0.1f;
+constexpr float kBounceThreshold = 1.0f;
+
+void primitiveMass(const QueryShape& s, float density, float& invMass, Vec3f& invInertia) {
+  float m;
+  Vec3f I;
+  switch (s.kind) {
+    case QueryShape::Kind::Sphere:
+      m = density * 4.f / 3.f * 3.14159265f * s.radius * s.radius * s.radius;
+      I = Vec3f::Constant(0.4f * m * s.radius * s.radius);
+      break;
+    case QueryShape::Kind::Capsule: {
+      // Cylinder of the core plus two hemispheres (a sphere), about the centre.
+      const float r = s.radius, h = 2 * s.halfHeight;
+      const float mc = density * 3.14159265f * r * r * h, ms = density * 4.f / 3.f * 3.14159265f * r * r * r;
+      m = mc + ms;
+      const float iz = mc * r * r / 2 + ms * 0.4f * r * r;
+      const float ix = mc * (3 * r * r + h * h) / 12 + ms * (0.4f * r * r + h * h / 4 + 3 * h * r / 8);
+      I = Vec3f(ix, ix, iz);
+      break;
+    }
+    default: {
+      const Vec3f e = s.halfExtents * 2.f;
+      m = density * e.prod();
+      I = Vec3f(e.y() * e.y() + e.z() * e.z(), e.x() * e.x() + e.z() * e.z(), e.x() * e.x() + e.y() * e.y()) * (m / 12.f);
+    }
+  }
+  invMass = 1.f / m;
+  invInertia = I.cwiseInverse();
+}
+
+uint64_t mixHash(uint64_t h, uint64_t v) {
+  h ^= v + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+  h *= 0xBF58476D1CE4E5B9ull;
+  return h ^ (h >> 31);
+}
+
+template <class T>
+uint64_t bitsOf(const T& v) {
+  uint64_t out = 0;
+  std::memcpy(&out, &v, std::min(sizeof(T), sizeof(out)));
+  return out;
+}
+
+}  // namespace
+
+World::World(const SceneDescription& scene, int threads) : scene_(scene), jobs_(threads) {
+  for (const GridDescription& g : scene_.grids) buildGrid(g);
+  for (const SpawnerDescription& s : scene_.spawners) spawn(s);
+}
+
+uint64_t World::brickCount() const {
+  uint64_t n = 0;
+  for (const auto& g : grids_) n += g->brickCount();
+  return n;
+}
+
+void World::buildGrid(const GridDescription& g) {
+  std::vector<Brick> bricks = g.generator.empty() ? g.bricks : generateBuild(g.generator, g.seed, g.scale).bricks;
+  auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(bricks.size() + 1024)));
+  for (const Brick& b : bricks) grid->placeBrick(b);
+  grids_.push_back(std::move(grid));
+  gridNames_.push_back(g.name);
+  addGridBody(uint32_t(grids_.size() - 1), g.position, g.rotation, g.motion, g.kinematic.linearVelocity, g.kinematic.angularVelocity);
+}
+
+uint32_t World::addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
+                            const Vec3d& linearVelocity, const Vec3f& angularVelocity) {
+  BodyShape shape;
+  shape.grid = gridIndex;
+  const BrickGrid& grid = *grids_[gridIndex];
+  uint32_t id;
+  if (motion != MotionType::Dynamic) {
+    // Static and kinematic grids move about their own origin (a station spins about its hub).
+    id = bodies_.add(position, rotation, motion, shape, 0.f, Vec3f::Zero());
+  } else {
+    // Body frame = centre of mass with principal axes; the grid sits inside it.
+    const MassProperties mp = grid.massProperties();
+    Eigen::SelfAdjointEigenSolver<Mat3d> eig(mp.inertia);
+    Mat3d axes = eig.eigenvectors();
+    if (axes.determinant() < 0) axes.col(2) = -axes.col(2);
+    const Quatf principal = Quatf(axes.cast<float>()).normalized();
+    const RigidTransform bodyInGrid{mp.centerOfMass, principal};
+    const RigidTransform gridPose{position, rotation};
+    const RigidTransform bodyPose = gridPose * bodyInGrid;
+    const Vec3f invI = eig.eigenvalues().cast<float>().cwiseMax(1e-12f).cwiseInverse();
+    id = bodies_.add(bodyPose.translation, bodyPose.rotation, motion, shape, float(1.0 / mp.mass), invI, bodyInGrid.inverse());
+  }
+  bodies_.linearVelocity[id] = linearVelocity.cast<float>();
+  bodies_.angularVelocity[id] = angularVelocity;
+  return id;
+}
+
+void World::spawn(const SpawnerDescription& s) {
+  SeededRandom r(s.seed);
+  for (uint32_t k = 0; k < s.count; ++k) {
+    const Vec3d p(r.uniform(s.regionMin.x(), s.regionMax.x()), r.uniform(s.regionMin.y(), s.regionMax.y()),
+                  r.uniform(s.regionMin.z(), s.regionMax.z()));
+    const Quatf q = Quatf(Eigen::AngleAxisf(float(r.uniform(0, 6.283)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized())).normalized();
+    if (s.shape == SpawnerDescription::Shape::Grid) {
+      const auto it = std::find(gridNames_.begin(), gridNames_.end(), s.grid);
+      addGridBody(uint32_t(it - gridNames_.begin()), p, q, MotionType::Dynamic, s.velocity, Vec3f::Zero());
+      continue;
+    }
+    BodyShape shape;
+    shape.primitive = s.shape == SpawnerDescription::Shape::Sphere  ? QueryShape::sphere(s.radius)
+                      : s.shape == SpawnerDescription::Shape::Capsule ? QueryShape::capsule(s.radius, s.halfHeight)
+                                                                       : QueryShape::box(s.halfExtents);
+    float invMass;
+    Vec3f invI;
+    primitiveMass(shape.primitive, s.density, invMass, invI);
+    const uint32_t id = bodies_.add(p, q, MotionType::Dynamic, shape, invMass, invI);
+    bodies_.linearVelocity[id] = s.velocity.cast<float>();
+  }
+}
+
+bool World::canCollide(uint32_t a, uint32_t b) const {
+  return bodies_.inverseMass[a] > 0.f || bodies_.inverseMass[b] > 0.f;
+}
+
+void World::computeBounds() {
+  const uint32_t n = bodies_.size();
+  bounds_.resize(n);
+  isStatic_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const RigidTransform pose = bodies_.shapePose(i);
+    const Mat3f R = pose.rotation.toRotationMatrix().cwiseAbs();
+    Vec3d centre, half;
+    if (bodies_.shape[i].isGrid()) {
+      const Aabb b = grids_[bodies_.shape[i].grid]->bounds();
+      centre = pose.pointToWorld(b.center());
+      half = (R * b.halfExtent()).cast<double>();
+    } else {
+      centre = pose.translation;
+      half = (R * bodies_.shape[i].primitive.localHalfExtents()).cast<double>();
+    }
+    // A margin of how far the body can move this frame keeps fast bodies in their pairs.
+    const double margin = 0.02 + double(bodies_.linearVelocity[i].norm()) * scene_.settings.timestep;
+    bounds_[i] = {centre - half - Vec3d::Constant(margin), centre + half + Vec3d::Constant(margin)};
+    isStatic_[i] = bodies_.motion[i] == MotionType::Static;
+  }
+}
+
+void World::generateContacts(float dt) {
+  const uint32_t n = uint32_t(pairs_.size());
+  if (pairContacts_.size() < n) {
+    pairContacts_.resize(n);
+    scratch_.resize(n);
+  }
+  pairFlipped_.assign(n, 0);
+  pairStats_.assign(n, ContactStats{});
+  ContactParams base;
+  base.lodFraction = scene_.settings.lodFraction;
+  // Convex approximations are cached per grid and refreshed lazily: warm them serially so the
+  // parallel stage only reads them (copies of one crate grid share one cache).
+  for (const BodyPair& p : pairs_) {
+    const BodyShape& sa = bodies_.shape[p.a];
+    const BodyShape& sb = bodies_.shape[p.b];
+    if (sa.isGrid() && sb.isGrid() && canCollide(p.a, p.b)) {
+      BrickGrid& ga = *grids_[sa.grid];
+      BrickGrid& gb = *grids_[sb.grid];
+      (ga.brickCount() <= gb.brickCount() ? ga : gb).convexApproximation(scene_.settings.approximationDepth);
+    }
+  }
+  // Each pair writes only its own slot: the result does not depend on the thread count.
+  jobs_.parallelFor(0, n, 4, [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) {
+      std::vector<Contact>& out = pairContacts_[k];
+      out.clear();
+      uint32_t a = pairs_[k].a, b = pairs_[k].b;
+      if (!canCollide(a, b)) continue;
+      // Speculative contacts: look as far ahead as the pair can close in one step, so fast
+      // bodies meet thin plates before they pass them (the solver lets gaps close, not cross).
+      ContactParams params = base;
+      params.speculativeMargin = 0.01f + (bodies_.linearVelocity[a] - bodies_.linearVelocity[b]).norm() * dt;
+      const BodyShape& sa = bodies_.shape[a];
+      const BodyShape& sb = bodies_.shape[b];
+      if (sa.isGrid() && sb.isGrid()) {
+        int smaller = 0;
+        collideGrids(*grids_[sa.grid], bodies_.shapePose(a), *grids_[sb.grid], bodies_.shapePose(b),
+                     scene_.settings.approximationDepth, params, scratch_[k], out, smaller, &pairStats_[k]);
+        pairFlipped_[k] = smaller == 1;  // normals point from the larger (a) to the smaller (b)
+      } else if (sa.isGrid() || sb.isGrid()) {
+        const uint32_t g = sa.isGrid() ? a : b, p = sa.isGrid() ? b : a;
+        grids_[bodies_.shape[g].grid]->collide(bodies_.shapePose(g), bodies_.shape[p].primitive, bodies_.shapePose(p), params,
+                                               scratch_[k], out, &pairStats_[k]);
+        pairFlipped_[k] = p == b;  // normals point from the grid towards the primitive
+      } else {
+        // Two primitives: in a frame at a's position (double -> float once, per the precision rule).
+        const RigidTransform frame{bodies_.position[a], Quatf::Identity()};
+        const RigidTransform pa = bodies_.shapePose(a), pb = bodies_.shapePose(b);
+        LocalContact c[kMaxContactsPerBrick];
+        const int m = collideShapes(sa.primitive, LocalPose{frame.pointToLocal(pa.translation), pa.rotation}, sb.primitive,
+                                    LocalPose{frame.pointToLocal(pb.translation), pb.rotation}, params.speculativeMargin, c);
+        for (int i = 0; i < m; ++i)
+          out.push_back({frame.pointToWorld(c[i].position), c[i].normal, c[i].depth, 0u, 0u});
+      }
+    }
+  });
+}
+
+void World::prepareSolver(float dt) {
+  contacts_.clear();
+  for (uint32_t k = 0; k < pairs_.size(); ++k) {
+    // Solver convention: the normal points from b towards a.
+    const uint32_t a = pairFlipped_[k] ? pairs_[k].b : pairs_[k].a;
+    const uint32_t b = pairFlipped_[k] ? pairs_[k].a : pairs_[k].b;
+    for (const Contact& c : pairContacts_[k]) {
+      SolverContact s;
+      s.a = a;
+      s.b = b;
+      s.point = c.position;
+      s.normal = c.normal;
+      s.depth = c.depth;
+      s.key = (uint64_t(pairs_[k].a) << 40) ^ (uint64_t(pairs_[k].b) << 20) ^ c.featureB;
+      s.rA = (c.position - bodies_.position[a]).cast<float>();
+      s.rB = (c.position - bodies_.position[b]).cast<float>();
+      const Vec3f n = s.normal;
+      s.t1 = (std::abs(n.x()) > 0.57f ? Vec3f(n.y(), -n.x(), 0) : Vec3f(0, n.z(), -n.y())).normalized();
+      s.t2 = n.cross(s.t1);
+      const Mat3f iA = bodies_.inverseInertiaWorld(a), iB = bodies_.inverseInertiaWorld(b);
+      auto mass = [&](const Vec3f& d) {
+        const float k = bodies_.inverseMass[a] + bodies_.inverseMass[b] + (iA * s.rA.cross(d)).cross(s.rA).dot(d) +
+                        (iB * s.rB.cross(d)).cross(s.rB).dot(d);
+        return k > 0 ? 1.f / k : 0.f;
+      };
+      s.massN = mass(n);
+      s.massT1 = mass(s.t1);
+      s.massT2 = mass(s.t2);
+      s.friction = std::sqrt(bodies_.friction[a] * bodies_.friction[b]);
+      const Vec3f vRel = bodies_.linearVelocity[a] + bodies_.angularVelocity[a].cross(s.rA) - bodies_.linearVelocity[b] -
+                         bodies_.angularVelocity[b].cross(s.rB);
+      const float vn = vRel.dot(n);
+      // Penetrating: push out (Baumgarte) and restitute fast impacts. Speculative (a gap of -depth):
+      // the bodies may approach by at most the gap this step.
+      s.bias = s.depth >= 0.f ? kBaumgarte / dt * std::max(s.depth - kSlop, 0.f) + (vn < -kBounceThreshold ? -kRestitution * vn : 0.f)
+                              : s.depth / dt;
+      // Warm start from the nearest cached impulse of the same pair and feature.
+      auto range = std::equal_range(cache_.begin(), cache_.end(), CachedImpulse{s.key, {}, 0, 0, 0},
+                                    [](const CachedImpulse& x, const CachedImpulse& y) { return x.key < y.key; });
+      double best = 0.05 * 0.05;
+      for (auto it = range.first; it != range.second; ++it) {
+        const double d2 = (it->point - s.point).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          s.lambdaN = it->n;
+          s.lambdaT1 = it->t1;
+          s.lambdaT2 = it->t2;
+        }
+      }
+      contacts_.push_back(s);
+    }
+  }
+  // Apply the warm-start impulses.
+  for (const SolverContact& s : contacts_) {
+    const Vec3f impulse = s.normal * s.lambdaN + s.t1 * s.lambdaT1 + s.t2 * s.lambdaT2;
+    bodies_.linearVelocity[s.a] += impulse * bodies_.inverseMass[s.a];
+    bodies_.angularVelocity[s.a] += bodies_.inverseInertiaWorld(s.a) * s.rA.cross(impulse);
+    bodies_.linearVelocity[s.b] -= impulse * bodies_.inverseMass[s.b];
+    bodies_.angularVelocity[s.b] -= bodies_.inverseInertiaWorld(s.b) * s.rB.cross(impulse);
+  }
+}
+
+void World::solve() {
+  for (int it = 0; it < scene_.settings.solverIterations; ++it) {
+    for (SolverContact& s : contacts_) {
+      const Mat3f iA = bodies_.inverseInertiaWorld(s.a), iB = bodies_.inverseInertiaWorld(s.b);
+      auto apply = [&](const Vec3f& impulse) {
+        bodies_.linearVelocity[s.a] += impulse * bodies_.inverseMass[s.a];
+        bodies_.angularVelocity[s.a] += iA * s.rA.cross(impulse);
+        bodies_.linearVelocity[s.b] -= impulse * bodies_.inverseMass[s.b];
+        bodies_.angularVelocity[s.b] -= iB * s.rB.cross(impulse);
+      };
+      auto relative = [&] {
+        return Vec3f(bodies_.linearVelocity[s.a] + bodies_.angularVelocity[s.a].cross(s.rA) - bodies_.linearVelocity[s.b] -
+                     bodies_.angularVelocity[s.b].cross(s.rB));
+      };
+      // Normal: accumulated impulse clamped at zero.
+      const float vn = relative().dot(s.normal);
+      float d = s.massN * (s.bias - vn);
+      const float oldN = s.lambdaN;
+      s.lambdaN = std::max(oldN + d, 0.f);
+      apply(s.normal * (s.lambdaN - oldN));
+      // Friction: each tangent clamped by the Coulomb bound.
+      const float limit = s.friction * s.lambdaN;
+      const Vec3f v = relative();
+      const float o1 = s.lambdaT1, o2 = s.lambdaT2;
+      s.lambdaT1 = std::clamp(o1 - s.massT1 * v.dot(s.t1), -limit, limit);
+      s.lambdaT2 = std::clamp(o2 - s.massT2 * v.dot(s.t2), -limit, limit);
+      apply(s.t1 * (s.lambdaT1 - o1) + s.t2 * (s.lambdaT2 - o2));
+    }
+  }
+  nextCache_.clear();
+  for (const SolverContact& s : contacts_) nextCache_.push_back({s.key, s.point, s.lambdaN, s.lambdaT1, s.lambdaT2});
+  std::stable_sort(nextCache_.begin(), nextCache_.end(), [](const CachedImpulse& x, const CachedImpulse& y) { return x.key < y.key; });
+  std::swap(cache_, nextCache_);
+}
+
+void World::integrate(float dt) {
+  for (uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.motion[i] == MotionType::Static) continue;
+    bodies_.position[i] += (bodies_.linearVelocity[i] * dt).cast<double>();
+    const Vec3f w = bodies_.angularVelocity[i];
+    const float angle = w.norm() * dt;
+    if (angle > 0) bodies_.rotation[i] = (Quatf(Eigen::AngleAxisf(angle, w / w.norm())) * bodies_.rotation[i]).normalized();
+  }
+}
+
+void World::substep(float dt) {
+  // Gravity on dynamic bodies first (semi-implicit Euler).
+  const Vec3f g = scene_.settings.gravity.cast<float>();
+  for (uint32_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.motion[i] == MotionType::Dynamic) bodies_.linearVelocity[i] += g * dt;
+  auto t = Clock::now();
+  {
+    ProfileZone z(profiler_, "broadphase", 0);
+    computeBounds();
+    broadphase_.update(bounds_, isStatic_, pairs_);
+  }
+  stats_.broadphaseMs += msSince(t);
+  t = Clock::now();
+  {
+    ProfileZone z(profiler_, "contacts", 1);
+    generateContacts(dt);
+  }
+  stats_.contactsMs += msSince(t);
+  t = Clock::now();
+  {
+    ProfileZone z(profiler_, "solve", 2);
+    prepareSolver(dt);
+    solve();
+  }
+  stats_.solverMs += msSince(t);
+  t = Clock::now();
+  {
+    ProfileZone z(profiler_, "integrate", 3);
+    integrate(dt);
+  }
+  stats_.integrateMs += msSince(t);
+  stats_.pairs += uint32_t(pairs_.size());
+  stats_.contacts += uint32_t(contacts_.size());
+  for (const ContactStats& s : pairStats_) {
+    stats_.boxTests += s.index.boxTests;
+    stats_.narrowphase += s.bricksTested;
+  }
+}
+
+void World::step() {
+  const auto t = Clock::now();
+  stats_ = StepStats{};
+  profiler_.beginFrame(frame_);
+  const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
+  for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt);
+  profiler_.endFrame();
+  stats_.totalMs = msSince(t);
+  ++frame_;
+}
+
+uint64_t World::stateHash() const {
+  uint64_t h = 0;
+  for (uint32_t i = 0; i < bodies_.size(); ++i) {
+    for (int k = 0; k < 3; ++k) h = mixHash(h, bitsOf(bodies_.position[i][k]));
+    for (int k = 0; k < 4; ++k) h = mixHash(h, bitsOf(bodies_.rotation[i].coeffs()[k]));
+    for (int k = 0; k < 3; ++k) h = mixHash(mixHash(h, bitsOf(bodies_.linearVelocity[i][k])), bitsOf(bodies_.angularVelocity[i][k]));
+  }
+  return h;
+}
+
+double World::energy() const {
+  double e = 0;
+  const Vec3d g = scene_.settings.gravity;
+  for (uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.motion[i] != MotionType::Dynamic) continue;
+    const double m = 1.0 / bodies_.inverseMass[i];
+    const Vec3f wl = bodies_.rotation[i].conjugate() * bodies_.angularVelocity[i];
+    e += 0.5 * m * bodies_.linearVelocity[i].squaredNorm();
+    e += 0.5 * double(wl.cwiseProduct(wl).dot(bodies_.inverseInertia[i].cwiseInverse()));
+    e -= m * g.dot(bodies_.position[i]);
+  }
+  return e;
+}
+
+}  // namespace bw
