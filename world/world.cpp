@@ -121,8 +121,10 @@ void World::spawn(const SpawnerDescription& s) {
                   r.uniform(s.regionMin.z(), s.regionMax.z()));
     const Quatf q = Quatf(Eigen::AngleAxisf(float(r.uniform(0, 6.283)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized())).normalized();
     if (s.shape == SpawnerDescription::Shape::Grid) {
+      // Grid copies keep their template's orientation (a ship is loaded upright); primitives
+      // get a random one.
       const auto it = std::find(gridNames_.begin(), gridNames_.end(), s.grid);
-      addGridBody(uint32_t(it - gridNames_.begin()), p, q, MotionType::Dynamic, s.velocity, Vec3f::Zero());
+      addGridBody(uint32_t(it - gridNames_.begin()), p, Quatf::Identity(), MotionType::Dynamic, s.velocity, Vec3f::Zero());
       continue;
     }
     BodyShape shape;
