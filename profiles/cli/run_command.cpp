@@ -1,8 +1,7 @@
-// `brickworld run [WORKLOAD]`: the default headless stress run.
-// Until the world and its scene files exist (issue 7), the workloads are the engine's
-// building blocks under stress:
-//   octobvh (default): load a seeded brick build into the OctoBVH with the article's load
-//     workload (insert each brick, query around it), then overlaps, rays, edits and memory.
+// `brickworld run [SCENE|octobvh|pool]`: the default headless stress run.
+//   SCENE (default crates_on_grid): a scene file, or the name of one in profiles/scenes.
+//   octobvh: load a seeded brick build into the OctoBVH with the article's load workload
+//     (insert each brick, query around it), then overlaps, rays, edits and memory.
 //   pool: grow a VirtualPool to N elements and free 99% of it in random order.
 #include <chrono>
 #include <cstdio>
@@ -158,13 +157,13 @@ int runOctoBvhStress(uint32_t elements, uint64_t seed, bool json) {
   return 0;
 }
 
-CommandRegistration reg{"run", "Headless stress run: a scene (file or shipped name) or the octobvh/pool workloads", [](CLI::App& cmd) {
-  auto workload = std::make_shared<std::string>("octobvh");
+CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_grid) or the octobvh/pool workloads", [](CLI::App& cmd) {
+  auto workload = std::make_shared<std::string>("crates_on_grid");
   auto elements = std::make_shared<uint32_t>(0);
   auto seed = std::make_shared<uint64_t>(1);
   auto json = std::make_shared<bool>(false);
   auto scene = std::make_shared<SceneRunOptions>();
-  cmd.add_option("workload", *workload, "a scene file or shipped scene name (crates_on_grid, ...), or octobvh (default) or pool");
+  cmd.add_option("workload", *workload, "a scene file or shipped scene name (default crates_on_grid), or the octobvh or pool workloads");
   cmd.add_option("--elements", *elements, "octobvh/pool: element count (default 1M bricks / 10M pool slots)")
       ->check(CLI::Range(1u, 1'000'000'000u));
   cmd.add_option("--seed", *seed, "octobvh/pool: random seed");
