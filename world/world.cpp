@@ -331,34 +331,36 @@ void World::integrate(float dt) {
   }
 }
 
-void World::substep(float dt) {
+void World::substep(float dt, int index) {
+  // Stages of successive substeps run one after another: distinct stage ids for work/span.
+  const int stage = index * 4;
   // Gravity on dynamic bodies first (semi-implicit Euler).
   const Vec3f g = scene_.settings.gravity.cast<float>();
   for (uint32_t i = 0; i < bodies_.size(); ++i)
     if (bodies_.motion[i] == MotionType::Dynamic) bodies_.linearVelocity[i] += g * dt;
   auto t = Clock::now();
   {
-    ProfileZone z(profiler_, "broadphase", 0);
+    ProfileZone z(profiler_, "broadphase", stage + 0);
     computeBounds();
     broadphase_.update(bounds_, isStatic_, pairs_);
   }
   stats_.broadphaseMs += msSince(t);
   t = Clock::now();
   {
-    ProfileZone z(profiler_, "contacts", 1);
+    ProfileZone z(profiler_, "contacts", stage + 1);
     generateContacts(dt);
   }
   stats_.contactsMs += msSince(t);
   t = Clock::now();
   {
-    ProfileZone z(profiler_, "solve", 2);
+    ProfileZone z(profiler_, "solve", stage + 2);
     prepareSolver(dt);
     solve();
   }
   stats_.solverMs += msSince(t);
   t = Clock::now();
   {
-    ProfileZone z(profiler_, "integrate", 3);
+    ProfileZone z(profiler_, "integrate", stage + 3);
     integrate(dt);
   }
   stats_.integrateMs += msSince(t);
@@ -375,7 +377,7 @@ void World::step() {
   stats_ = StepStats{};
   profiler_.beginFrame(frame_);
   const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
-  for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt);
+  for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt, s);
   profiler_.endFrame();
   stats_.totalMs = msSince(t);
   ++frame_;

@@ -48,6 +48,8 @@ class World {
   const SceneDescription& scene() const { return scene_; }
   Profiler& profiler() { return profiler_; }
   uint64_t brickCount() const;
+  /// The world's grids (shared by every body that is a copy of them).
+  const BrickGrid& grid(uint32_t index) const { return *grids_[index]; }
   /// Hash of every body's position, rotation and velocities (bit patterns).
   uint64_t stateHash() const;
   /// Kinetic plus potential energy of the dynamic bodies (for drift checks).
@@ -74,7 +76,7 @@ class World {
   void spawn(const SpawnerDescription& s);
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
-  void substep(float dt);
+  void substep(float dt, int index);
   void computeBounds();
   void generateContacts(float dt);
   void prepareSolver(float dt);

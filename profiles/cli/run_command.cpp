@@ -171,6 +171,8 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
   cmd.add_option("--threads", scene->threads, "scene: worker threads")->check(CLI::Range(1, 1024));
   cmd.add_option("--csv", scene->csvPath, "scene: write per-frame stage times to this CSV");
   cmd.add_option("--trace", scene->tracePath, "scene: write a Chrome trace (open in Perfetto)");
+  cmd.add_option("--engine", scene->engine, "scene: brickworld (default), bullet, or both (same initial state, ratio)")
+      ->check(CLI::IsMember({"brickworld", "bullet", "both"}));
   cmd.add_flag("--json", *json, "print one JSON object");
   return [=] {
     if (*workload == "pool") return runPoolStress(*elements ? *elements : 10'000'000, *seed, *json);

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "world/bullet_baseline.h"
 #include "world/scene_file.h"
 #include "world/world.h"
 
@@ -46,12 +47,54 @@ std::string resolveScenePath(const std::string& scene) {
   throw SceneError(scene + ": no such scene file, and no shipped scene of that name in " + BW_SOURCE_DIR + "/profiles/scenes");
 }
 
+// The same scene in Bullet (btDiscreteDynamicsWorld, grids as btCompoundShape), from the World's
+// initial state. Returns the median frame time.
+double runBullet(const World& initial, uint32_t frames, bool json, nlohmann::json& out) {
+  using Clock = std::chrono::steady_clock;
+  BulletBaseline bullet(initial);
+  Series total;
+  uint64_t contacts = 0;
+  for (uint32_t f = 0; f < frames; ++f) {
+    const auto t = Clock::now();
+    bullet.step();
+    total.v.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+    contacts += bullet.contactCount();
+    if (!json && frames >= 100 && (f + 1) % (frames / 10) == 0)
+      std::fprintf(stderr, "  bullet frame %u/%u  %.2f ms\n", f + 1, frames, total.v.back());
+  }
+  uint32_t resting, moving;
+  double lowest;
+  bullet.restingReport(resting, moving, lowest);
+  out = {{"build_ms", bullet.buildSeconds() * 1e3},
+         {"frame", {{"median_ms", total.quantile(0.5)}, {"p95_ms", total.quantile(0.95)}, {"max_ms", total.max()}}},
+         {"contacts_per_frame", double(contacts) / frames},
+         {"dynamic_resting", resting},
+         {"dynamic_moving", moving},
+         {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0}};
+  if (!json) {
+    std::printf("bullet baseline (btDiscreteDynamicsWorld, grids as btCompoundShape): compounds built in %.0f ms\n",
+                bullet.buildSeconds() * 1e3);
+    std::printf("  frame       %7.3f ms %7.3f ms %7.3f ms   (median, p95, max)\n", total.quantile(0.5), total.quantile(0.95), total.max());
+    std::printf("  per frame: %.0f contacts; dynamic bodies at the end: %u resting, %u moving, lowest at z = %.2f\n",
+                double(contacts) / frames, resting, moving, std::isfinite(lowest) ? lowest : 0.0);
+  }
+  return total.quantile(0.5);
+}
+
 int runScene(const SceneRunOptions& o) {
   using Clock = std::chrono::steady_clock;
   const std::string path = resolveScenePath(o.scene);
   const SceneDescription scene = loadScene(path);
+  if (o.engine != "brickworld" && o.engine != "bullet" && o.engine != "both")
+    throw std::invalid_argument("--engine must be brickworld, bullet or both (got '" + o.engine + "')");
   const auto tBuild = Clock::now();
   World world(scene, o.threads);
+  if (o.engine == "bullet") {
+    nlohmann::json b;
+    runBullet(world, o.frames ? o.frames : scene.settings.frames, o.json, b);
+    if (o.json) std::cout << nlohmann::json{{"scene", scene.name}, {"engine", "bullet"}, {"bullet", b}}.dump(2) << "\n";
+    return 0;
+  }
   const double buildMs = std::chrono::duration<double, std::milli>(Clock::now() - tBuild).count();
   const uint32_t frames = o.frames ? o.frames : scene.settings.frames;
 
@@ -122,6 +165,13 @@ int runScene(const SceneRunOptions& o) {
                      {"dynamic_moving", moving},
                      {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
                      {"state_hash", world.stateHash()}};
+    if (o.engine == "both") {
+      nlohmann::json b;
+      World fresh(scene, o.threads);
+      const double bulletMedian = runBullet(fresh, frames, true, b);
+      j["bullet"] = b;
+      j["bullet_over_brickworld_median"] = bulletMedian / std::max(total.quantile(0.5), 1e-9);
+    }
     std::cout << j.dump(2) << "\n";
     return 0;
   }
@@ -138,6 +188,12 @@ int runScene(const SceneRunOptions& o) {
   std::printf("  work %.1f ms, span %.1f ms over the run\n", work, span);
   if (!o.csvPath.empty()) std::printf("  per-frame CSV: %s\n", o.csvPath.c_str());
   if (!o.tracePath.empty()) std::printf("  Chrome trace: %s (open in Perfetto)\n", o.tracePath.c_str());
+  if (o.engine == "both") {
+    nlohmann::json b;
+    World fresh(scene, o.threads);
+    const double bulletMedian = runBullet(fresh, frames, false, b);
+    std::printf("bullet / brickworld median frame time: %.1fx\n", bulletMedian / std::max(total.quantile(0.5), 1e-9));
+  }
   return 0;
 }
 
