@@ -23,6 +23,8 @@ constexpr float kBaumgarte = 0.2f;
 constexpr float kSlop = 0.005f;
 constexpr float kRestitution = 0.1f;
 constexpr float kBounceThreshold = 1.0f;
+// Sleeping: an island whose bodies all stayed below these speeds for kSleepTime seconds sleeps.
+constexpr float kSleepLinear = 0.05f, kSleepAngular = 0.1f, kSleepTime = 0.5f;
 
 void primitiveMass(const QueryShape& s, float density, float& invMass, Vec3f& invInertia) {
   float m;
@@ -70,6 +72,14 @@ uint64_t bitsOf(const T& v) {
 World::World(const SceneDescription& scene, int threads) : scene_(scene), jobs_(threads) {
   for (const GridDescription& g : scene_.grids) buildGrid(g);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
+  stillTime_.assign(bodies_.size(), 0.f);
+  asleep_.assign(bodies_.size(), 0);
+}
+
+uint32_t World::sleepingCount() const {
+  uint32_t n = 0;
+  for (uint8_t a : asleep_) n += a;
+  return n;
 }
 
 uint64_t World::brickCount() const {
@@ -181,7 +191,7 @@ void World::generateContacts(float dt) {
   for (const BodyPair& p : pairs_) {
     const BodyShape& sa = bodies_.shape[p.a];
     const BodyShape& sb = bodies_.shape[p.b];
-    if (sa.isGrid() && sb.isGrid() && canCollide(p.a, p.b)) {
+    if (sa.isGrid() && sb.isGrid() && canCollide(p.a, p.b) && (active(p.a) || active(p.b))) {
       BrickGrid& ga = *grids_[sa.grid];
       BrickGrid& gb = *grids_[sb.grid];
       (ga.brickCount() <= gb.brickCount() ? ga : gb).convexApproximation(scene_.settings.approximationDepth);
@@ -193,7 +203,7 @@ void World::generateContacts(float dt) {
       std::vector<Contact>& out = pairContacts_[k];
       out.clear();
       uint32_t a = pairs_[k].a, b = pairs_[k].b;
-      if (!canCollide(a, b)) continue;
+      if (!canCollide(a, b) || (!active(a) && !active(b))) continue;  // nothing awake: nothing to do
       // Speculative contacts: look as far ahead as the pair can close in one step, so fast
       // bodies meet thin plates before they pass them (the solver lets gaps close, not cross).
       ContactParams params = base;
@@ -226,6 +236,8 @@ void World::generateContacts(float dt) {
 
 void World::prepareSolver(float dt) {
   contacts_.clear();
+  inverseInertiaWorld_.resize(bodies_.size());
+  for (uint32_t i = 0; i < bodies_.size(); ++i) inverseInertiaWorld_[i] = bodies_.inverseInertiaWorld(i);
   for (uint32_t k = 0; k < pairs_.size(); ++k) {
     // Solver convention: the normal points from b towards a.
     const uint32_t a = pairFlipped_[k] ? pairs_[k].b : pairs_[k].a;
@@ -243,15 +255,20 @@ void World::prepareSolver(float dt) {
       const Vec3f n = s.normal;
       s.t1 = (std::abs(n.x()) > 0.57f ? Vec3f(n.y(), -n.x(), 0) : Vec3f(0, n.z(), -n.y())).normalized();
       s.t2 = n.cross(s.t1);
-      const Mat3f iA = bodies_.inverseInertiaWorld(a), iB = bodies_.inverseInertiaWorld(b);
-      auto mass = [&](const Vec3f& d) {
-        const float k = bodies_.inverseMass[a] + bodies_.inverseMass[b] + (iA * s.rA.cross(d)).cross(s.rA).dot(d) +
-                        (iB * s.rB.cross(d)).cross(s.rB).dot(d);
-        return k > 0 ? 1.f / k : 0.f;
-      };
-      s.massN = mass(n);
-      s.massT1 = mass(s.t1);
-      s.massT2 = mass(s.t2);
+      const Mat3f& iA = inverseInertiaWorld_[a];
+      const Mat3f& iB = inverseInertiaWorld_[b];
+      const Vec3f dirs[3] = {n, s.t1, s.t2};
+      float masses[3];
+      for (int d = 0; d < 3; ++d) {
+        s.angA[d] = iA * s.rA.cross(dirs[d]);
+        s.angB[d] = iB * s.rB.cross(dirs[d]);
+        const float k = bodies_.inverseMass[a] + bodies_.inverseMass[b] + s.angA[d].cross(s.rA).dot(dirs[d]) +
+                        s.angB[d].cross(s.rB).dot(dirs[d]);
+        masses[d] = k > 0 ? 1.f / k : 0.f;
+      }
+      s.massN = masses[0];
+      s.massT1 = masses[1];
+      s.massT2 = masses[2];
       s.friction = std::sqrt(bodies_.friction[a] * bodies_.friction[b]);
       const Vec3f vRel = bodies_.linearVelocity[a] + bodies_.angularVelocity[a].cross(s.rA) - bodies_.linearVelocity[b] -
                          bodies_.angularVelocity[b].cross(s.rB);
@@ -276,54 +293,144 @@ void World::prepareSolver(float dt) {
       contacts_.push_back(s);
     }
   }
-  // Apply the warm-start impulses.
+  // A sleeping body touched by an awake one wakes up (its island rejoins the simulation).
   for (const SolverContact& s : contacts_) {
-    const Vec3f impulse = s.normal * s.lambdaN + s.t1 * s.lambdaT1 + s.t2 * s.lambdaT2;
-    bodies_.linearVelocity[s.a] += impulse * bodies_.inverseMass[s.a];
-    bodies_.angularVelocity[s.a] += bodies_.inverseInertiaWorld(s.a) * s.rA.cross(impulse);
-    bodies_.linearVelocity[s.b] -= impulse * bodies_.inverseMass[s.b];
-    bodies_.angularVelocity[s.b] -= bodies_.inverseInertiaWorld(s.b) * s.rB.cross(impulse);
+    for (uint32_t x : {s.a, s.b})
+      if (asleep_[x]) {
+        asleep_[x] = 0;
+        stillTime_[x] = 0.f;
+      }
   }
 }
 
-void World::solve() {
+// Islands: dynamic bodies joined by contacts (static and kinematic bodies do not join islands,
+// they are read but never written by the solver). Union-find with the smaller id as root makes
+// the grouping a pure function of the contact list.
+void World::buildIslands() {
+  const uint32_t n = bodies_.size();
+  islandOf_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) islandOf_[i] = i;
+  auto find = [&](uint32_t x) {
+    while (islandOf_[x] != x) x = islandOf_[x] = islandOf_[islandOf_[x]];
+    return x;
+  };
+  for (const SolverContact& c : contacts_) {
+    if (bodies_.motion[c.a] != MotionType::Dynamic || bodies_.motion[c.b] != MotionType::Dynamic) continue;
+    const uint32_t ra = find(c.a), rb = find(c.b);
+    if (ra != rb) islandOf_[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  // Contacts grouped by the island of their dynamic body, islands ordered by root id (CSR).
+  std::vector<uint32_t>& start = islandStart_;
+  std::vector<uint32_t> rootIndex(n, 0xFFFFFFFFu);
+  std::vector<uint32_t> roots;
+  auto islandOfContact = [&](const SolverContact& c) {
+    return find(bodies_.motion[c.a] == MotionType::Dynamic ? c.a : c.b);
+  };
+  for (const SolverContact& c : contacts_) {
+    const uint32_t r = islandOfContact(c);
+    if (rootIndex[r] == 0xFFFFFFFFu) {
+      rootIndex[r] = 0;
+      roots.push_back(r);
+    }
+  }
+  std::sort(roots.begin(), roots.end());
+  for (uint32_t i = 0; i < roots.size(); ++i) rootIndex[roots[i]] = i;
+  start.assign(roots.size() + 1, 0);
+  for (const SolverContact& c : contacts_) ++start[rootIndex[islandOfContact(c)] + 1];
+  for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  islandContacts_.resize(contacts_.size());
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (uint32_t k = 0; k < contacts_.size(); ++k) islandContacts_[fill[rootIndex[islandOfContact(contacts_[k])]]++] = k;
+}
+
+void World::solveIsland(uint32_t island) {
+  const uint32_t begin = islandStart_[island], end = islandStart_[island + 1];
+  auto apply = [&](const SolverContact& s, int d, const Vec3f& dir, float lambda) {
+    if (bodies_.motion[s.a] == MotionType::Dynamic) {
+      bodies_.linearVelocity[s.a] += dir * (lambda * bodies_.inverseMass[s.a]);
+      bodies_.angularVelocity[s.a] += s.angA[d] * lambda;
+    }
+    if (bodies_.motion[s.b] == MotionType::Dynamic) {
+      bodies_.linearVelocity[s.b] -= dir * (lambda * bodies_.inverseMass[s.b]);
+      bodies_.angularVelocity[s.b] -= s.angB[d] * lambda;
+    }
+  };
+  // Warm start, then iterate.
+  for (uint32_t k = begin; k < end; ++k) {
+    const SolverContact& s = contacts_[islandContacts_[k]];
+    apply(s, 0, s.normal, s.lambdaN);
+    apply(s, 1, s.t1, s.lambdaT1);
+    apply(s, 2, s.t2, s.lambdaT2);
+  }
   for (int it = 0; it < scene_.settings.solverIterations; ++it) {
-    for (SolverContact& s : contacts_) {
-      const Mat3f iA = bodies_.inverseInertiaWorld(s.a), iB = bodies_.inverseInertiaWorld(s.b);
-      auto apply = [&](const Vec3f& impulse) {
-        bodies_.linearVelocity[s.a] += impulse * bodies_.inverseMass[s.a];
-        bodies_.angularVelocity[s.a] += iA * s.rA.cross(impulse);
-        bodies_.linearVelocity[s.b] -= impulse * bodies_.inverseMass[s.b];
-        bodies_.angularVelocity[s.b] -= iB * s.rB.cross(impulse);
-      };
+    // note: sweeps alternate direction (symmetric Gauss-Seidel) so no contact is always solved
+    // last; a fixed order makes friction in stacks creep one way.
+    for (uint32_t j = begin; j < end; ++j) {
+      const uint32_t k = (it & 1) ? end - 1 - (j - begin) : j;
+      SolverContact& s = contacts_[islandContacts_[k]];
       auto relative = [&] {
         return Vec3f(bodies_.linearVelocity[s.a] + bodies_.angularVelocity[s.a].cross(s.rA) - bodies_.linearVelocity[s.b] -
                      bodies_.angularVelocity[s.b].cross(s.rB));
       };
       // Normal: accumulated impulse clamped at zero.
-      const float vn = relative().dot(s.normal);
-      float d = s.massN * (s.bias - vn);
       const float oldN = s.lambdaN;
-      s.lambdaN = std::max(oldN + d, 0.f);
-      apply(s.normal * (s.lambdaN - oldN));
+      s.lambdaN = std::max(oldN + s.massN * (s.bias - relative().dot(s.normal)), 0.f);
+      apply(s, 0, s.normal, s.lambdaN - oldN);
       // Friction: each tangent clamped by the Coulomb bound.
       const float limit = s.friction * s.lambdaN;
       const Vec3f v = relative();
       const float o1 = s.lambdaT1, o2 = s.lambdaT2;
       s.lambdaT1 = std::clamp(o1 - s.massT1 * v.dot(s.t1), -limit, limit);
       s.lambdaT2 = std::clamp(o2 - s.massT2 * v.dot(s.t2), -limit, limit);
-      apply(s.t1 * (s.lambdaT1 - o1) + s.t2 * (s.lambdaT2 - o2));
+      apply(s, 1, s.t1, s.lambdaT1 - o1);
+      apply(s, 2, s.t2, s.lambdaT2 - o2);
     }
   }
+}
+
+void World::solve() {
+  buildIslands();
+  // Islands touch disjoint dynamic bodies: solving them in parallel is race-free and gives the
+  // same result as solving them one by one.
+  const uint32_t islands = uint32_t(islandStart_.size() - 1);
+  jobs_.parallelFor(0, islands, 1, [&](uint32_t b, uint32_t e) {
+    for (uint32_t i = b; i < e; ++i) solveIsland(i);
+  });
   nextCache_.clear();
   for (const SolverContact& s : contacts_) nextCache_.push_back({s.key, s.point, s.lambdaN, s.lambdaT1, s.lambdaT2});
   std::stable_sort(nextCache_.begin(), nextCache_.end(), [](const CachedImpulse& x, const CachedImpulse& y) { return x.key < y.key; });
   std::swap(cache_, nextCache_);
 }
 
+// Bodies that stay nearly still accumulate still time; an island sleeps when all of its bodies
+// have been still for kSleepTime (so a resting pile sleeps together and wakes together).
+void World::updateSleep(float dt) {
+  if (!scene_.settings.sleeping) return;
+  const uint32_t n = bodies_.size();
+  for (uint32_t i = 0; i < n; ++i) {
+    if (bodies_.motion[i] != MotionType::Dynamic || asleep_[i]) continue;
+    const bool still = bodies_.linearVelocity[i].norm() < kSleepLinear && bodies_.angularVelocity[i].norm() < kSleepAngular;
+    stillTime_[i] = still ? stillTime_[i] + dt : 0.f;
+  }
+  // An island may sleep only if every member is ready; islandOf_ holds this substep's roots.
+  std::vector<uint8_t> blocked(n, 0);
+  auto root = [&](uint32_t x) {
+    while (islandOf_[x] != x) x = islandOf_[x];
+    return x;
+  };
+  for (uint32_t i = 0; i < n; ++i)
+    if (bodies_.motion[i] == MotionType::Dynamic && !asleep_[i] && stillTime_[i] < kSleepTime) blocked[root(i)] = 1;
+  for (uint32_t i = 0; i < n; ++i) {
+    if (bodies_.motion[i] != MotionType::Dynamic || asleep_[i] || blocked[root(i)]) continue;
+    asleep_[i] = 1;
+    bodies_.linearVelocity[i] = Vec3f::Zero();
+    bodies_.angularVelocity[i] = Vec3f::Zero();
+  }
+}
+
 void World::integrate(float dt) {
   for (uint32_t i = 0; i < bodies_.size(); ++i) {
-    if (bodies_.motion[i] == MotionType::Static) continue;
+    if (bodies_.motion[i] == MotionType::Static || asleep_[i]) continue;
     bodies_.position[i] += (bodies_.linearVelocity[i] * dt).cast<double>();
     const Vec3f w = bodies_.angularVelocity[i];
     const float angle = w.norm() * dt;
@@ -337,7 +444,7 @@ void World::substep(float dt, int index) {
   // Gravity on dynamic bodies first (semi-implicit Euler).
   const Vec3f g = scene_.settings.gravity.cast<float>();
   for (uint32_t i = 0; i < bodies_.size(); ++i)
-    if (bodies_.motion[i] == MotionType::Dynamic) bodies_.linearVelocity[i] += g * dt;
+    if (bodies_.motion[i] == MotionType::Dynamic && !asleep_[i]) bodies_.linearVelocity[i] += g * dt;
   auto t = Clock::now();
   {
     ProfileZone z(profiler_, "broadphase", stage + 0);
@@ -362,6 +469,7 @@ void World::substep(float dt, int index) {
   {
     ProfileZone z(profiler_, "integrate", stage + 3);
     integrate(dt);
+    updateSleep(dt);
   }
   stats_.integrateMs += msSince(t);
   stats_.pairs += uint32_t(pairs_.size());

@@ -9,10 +9,11 @@
 ///
 /// What is in this first version: static, kinematic and dynamic bodies (primitives and grids,
 /// grids shared between copies), sweep-and-prune broadphase, primitive-vs-grid, grid-vs-grid
-/// (convex approximation) and primitive-vs-primitive contacts, a sequential-impulse solver with
-/// friction, restitution and warm starting matched by contact feature, semi-implicit Euler
-/// integration with substeps. Not yet: islands solved in parallel, sleeping, continuous
-/// collision, terrain (the scene schema has no terrain yet either).
+/// (convex approximation) and primitive-vs-primitive contacts with speculative margins, a
+/// sequential-impulse solver with friction, restitution and warm starting matched by contact
+/// feature, islands (union-find over contacts) solved in parallel, sleeping islands, and
+/// semi-implicit Euler integration with substeps. Not yet: splitting one huge island across
+/// threads, a pair cache, terrain (the scene schema has no terrain yet either).
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -54,6 +55,8 @@ class World {
   uint64_t stateHash() const;
   /// Kinetic plus potential energy of the dynamic bodies (for drift checks).
   double energy() const;
+  /// Dynamic bodies currently asleep.
+  uint32_t sleepingCount() const;
 
  private:
   struct SolverContact {
@@ -63,6 +66,9 @@ class World {
     float depth;
     uint64_t key;          // pair and feature, for warm starting
     Vec3f rA, rB, t1, t2;
+    // Angular response per unit impulse along n, t1, t2 (inverse inertia x (r x d)), computed
+    // once per substep so iterations are multiply-adds.
+    Vec3f angA[3], angB[3];
     float massN, massT1, massT2, bias, friction;
     float lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0;
   };
@@ -81,6 +87,12 @@ class World {
   void generateContacts(float dt);
   void prepareSolver(float dt);
   void solve();
+  void solveIsland(uint32_t island);
+  void buildIslands();
+  void updateSleep(float dt);
+  bool active(uint32_t body) const {
+    return bodies_.motion[body] == MotionType::Kinematic || (bodies_.motion[body] == MotionType::Dynamic && !asleep_[body]);
+  }
   void integrate(float dt);
   bool canCollide(uint32_t a, uint32_t b) const;
 
@@ -99,6 +111,12 @@ class World {
   std::vector<uint8_t> pairFlipped_;                // slot's contacts have normal from pair.a to pair.b
   std::vector<ContactStats> pairStats_;
   std::vector<SolverContact> contacts_;
+  std::vector<Mat3f> inverseInertiaWorld_;          // per body, this substep
+  std::vector<uint32_t> islandOf_;                  // union-find parent per body
+  std::vector<uint32_t> islandStart_, islandContacts_;  // contacts grouped by island (CSR)
+  std::vector<uint32_t> islandBodiesStart_, islandBodies_;
+  std::vector<float> stillTime_;                    // seconds each body has been nearly still
+  std::vector<uint8_t> asleep_;
   std::vector<CachedImpulse> cache_, nextCache_;
   StepStats stats_;
   uint32_t frame_ = 0;

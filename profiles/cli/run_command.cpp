@@ -173,6 +173,8 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
   cmd.add_option("--trace", scene->tracePath, "scene: write a Chrome trace (open in Perfetto)");
   cmd.add_option("--engine", scene->engine, "scene: brickworld (default), bullet, or both (same initial state, ratio)")
       ->check(CLI::IsMember({"brickworld", "bullet", "both"}));
+  cmd.add_option("--sleeping", scene->sleeping, "scene: on/off overrides the scene's sleeping setting")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd.add_flag("--json", *json, "print one JSON object");
   return [=] {
     if (*workload == "pool") return runPoolStress(*elements ? *elements : 10'000'000, *seed, *json);

@@ -84,7 +84,8 @@ double runBullet(const World& initial, uint32_t frames, bool json, nlohmann::jso
 int runScene(const SceneRunOptions& o) {
   using Clock = std::chrono::steady_clock;
   const std::string path = resolveScenePath(o.scene);
-  const SceneDescription scene = loadScene(path);
+  SceneDescription scene = loadScene(path);
+  if (!o.sleeping.empty()) scene.settings.sleeping = o.sleeping == "on";
   if (o.engine != "brickworld" && o.engine != "bullet" && o.engine != "both")
     throw std::invalid_argument("--engine must be brickworld, bullet or both (got '" + o.engine + "')");
   const auto tBuild = Clock::now();
@@ -162,6 +163,7 @@ int runScene(const SceneRunOptions& o) {
                      {"box_tests_per_frame", double(boxTests) / frames},
                      {"peak_resident_mib", peakResidentMiB()},
                      {"dynamic_resting", resting},
+                     {"dynamic_asleep", world.sleepingCount()},
                      {"dynamic_moving", moving},
                      {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
                      {"state_hash", world.stateHash()}};
@@ -183,7 +185,8 @@ int runScene(const SceneRunOptions& o) {
     std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
   std::printf("  per frame: %.0f pairs, %.0f contacts, %.0f box tests\n", double(pairs) / frames, double(contactCount) / frames,
               double(boxTests) / frames);
-  std::printf("  dynamic bodies at the end: %u resting, %u moving, lowest at z = %.2f\n", resting, moving, std::isfinite(lowest) ? lowest : 0.0);
+  std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
+              world.sleepingCount(), moving, std::isfinite(lowest) ? lowest : 0.0);
   std::printf("  peak memory %.0f MiB; state hash %016llx\n", peakResidentMiB(), (unsigned long long)world.stateHash());
   std::printf("  work %.1f ms, span %.1f ms over the run\n", work, span);
   if (!o.csvPath.empty()) std::printf("  per-frame CSV: %s\n", o.csvPath.c_str());

@@ -13,7 +13,8 @@ struct SceneRunOptions {
   std::string tracePath;    ///< Chrome trace of the whole run
   bool json = false;
   bool progress = true;
-  std::string engine = "brickworld";  ///< brickworld, bullet, or both (same initial state, ratio printed)
+  std::string engine = "brickworld";
+  std::string sleeping;     ///< "on"/"off" overrides the scene's setting; empty keeps it  ///< brickworld, bullet, or both (same initial state, ratio printed)
 };
 
 /// Runs the scene and prints the report; returns the process exit code.
