@@ -75,7 +75,7 @@ uint32_t PoolIndexSpace::acquire() {
   uint32_t slot;
   if (m.freeHead != kInvalid) {
     slot = b * slotsPerBlock_ + m.freeHead;
-    m.freeHead = freeLink(slot);
+    m.freeHead = readFreeLink(slot);
   } else {
     slot = b * slotsPerBlock_ + m.bump++;
   }
@@ -99,7 +99,7 @@ void PoolIndexSpace::release(uint32_t index) {
   liveBits_[index >> 6] &= ~(uint64_t(1) << (index & 63));
   --live_;
   if (m.live-- == slotsPerBlock_) pushAvailable(b);
-  freeLink(index) = m.freeHead;
+  writeFreeLink(index, m.freeHead);
   m.freeHead = index - b * slotsPerBlock_;
   if (m.live == 0) {
     if (spare_ != kInvalid) releaseBlock(spare_);

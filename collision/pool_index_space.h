@@ -13,6 +13,7 @@
 /// Thread safety: none; one writer at a time. Elements never move while live.
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -79,9 +80,14 @@ class PoolIndexSpace {
   };
   static_assert(sizeof(BlockMeta) == 24);
 
-  uint32_t& freeLink(uint32_t index) const {
-    return *reinterpret_cast<uint32_t*>(columns_[0] + size_t(index) * strides_[0]);
+  // note: the link lives in the free slot's first 4 bytes through memcpy, so element types
+  // with alignment below 4 (byte arrays, packed structs) are fine.
+  uint32_t readFreeLink(uint32_t index) const {
+    uint32_t v;
+    std::memcpy(&v, columns_[0] + size_t(index) * strides_[0], sizeof v);
+    return v;
   }
+  void writeFreeLink(uint32_t index, uint32_t v) const { std::memcpy(columns_[0] + size_t(index) * strides_[0], &v, sizeof v); }
   void pushAvailable(uint32_t b);
   void removeAvailable(uint32_t b);
   void releaseBlock(uint32_t b);

@@ -199,6 +199,7 @@ void World::generateContacts(float dt) {
   }
   // Each pair writes only its own slot: the result does not depend on the thread count.
   jobs_.parallelFor(0, n, 4, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler_, "contacts", stage_ + 1);
     for (uint32_t k = begin; k < end; ++k) {
       std::vector<Contact>& out = pairContacts_[k];
       out.clear();
@@ -389,11 +390,11 @@ void World::solveIsland(uint32_t island) {
 }
 
 void World::solve() {
-  buildIslands();
   // Islands touch disjoint dynamic bodies: solving them in parallel is race-free and gives the
   // same result as solving them one by one.
   const uint32_t islands = uint32_t(islandStart_.size() - 1);
   jobs_.parallelFor(0, islands, 1, [&](uint32_t b, uint32_t e) {
+    ProfileZone zone(profiler_, "island", stage_ + 3);
     for (uint32_t i = b; i < e; ++i) solveIsland(i);
   });
   nextCache_.clear();
@@ -440,7 +441,9 @@ void World::integrate(float dt) {
 
 void World::substep(float dt, int index) {
   // Stages of successive substeps run one after another: distinct stage ids for work/span.
-  const int stage = index * 4;
+  // Serial stages record one zone; parallel stages one zone per chunk (the jobs).
+  const int stage = index * 5;
+  stage_ = stage;
   // Gravity on dynamic bodies first (semi-implicit Euler).
   const Vec3f g = scene_.settings.gravity.cast<float>();
   for (uint32_t i = 0; i < bodies_.size(); ++i)
@@ -454,20 +457,24 @@ void World::substep(float dt, int index) {
   stats_.broadphaseMs += msSince(t);
   t = Clock::now();
   {
-    ProfileZone z(profiler_, "contacts", stage + 1);
+    ProfileZone z(profiler_, "contacts (stage)");
     generateContacts(dt);
   }
   stats_.contactsMs += msSince(t);
   t = Clock::now();
   {
-    ProfileZone z(profiler_, "solve", stage + 2);
-    prepareSolver(dt);
+    {
+      ProfileZone z(profiler_, "prepare solver", stage + 2);
+      prepareSolver(dt);
+      buildIslands();
+    }
+    ProfileZone z(profiler_, "solve (stage)");
     solve();
   }
   stats_.solverMs += msSince(t);
   t = Clock::now();
   {
-    ProfileZone z(profiler_, "integrate", stage + 3);
+    ProfileZone z(profiler_, "integrate", stage + 4);
     integrate(dt);
     updateSleep(dt);
   }

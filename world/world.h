@@ -120,6 +120,7 @@ class World {
   std::vector<CachedImpulse> cache_, nextCache_;
   StepStats stats_;
   uint32_t frame_ = 0;
+  int stage_ = 0;  // first profiling stage id of the running substep
 };
 
 }  // namespace bw

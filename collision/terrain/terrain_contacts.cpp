@@ -1,0 +1,360 @@
+#include "collision/terrain/terrain_contacts.h"
+
+#include <BulletCollision/CollisionShapes/btBoxShape.h>
+#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
+#include <BulletCollision/CollisionShapes/btTriangleShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
+#include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
+#include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
+#include <LinearMath/btConvexHullComputer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "collision/input_validation.h"
+#include "collision/terrain/triangle_contacts.h"
+
+namespace bw {
+namespace {
+
+btVector3 toBt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
+Vec3f fromBt(const btVector3& v) { return Vec3f(v.x(), v.y(), v.z()); }
+
+/// Shape placed in a chunk's local frame.
+struct LocalShape {
+  Vec3f centre;
+  Mat3f rot;
+  Vec3f halfBounds;      ///< half extents of its local AABB
+  Vec3f corners[8];      ///< box corners (box only)
+  const Vec3f* points;   ///< hull points in shape frame
+  uint32_t pointCount;
+  Vec3f vertex(uint32_t i) const { return points ? Vec3f(rot * points[i] + centre) : corners[i]; }
+  uint32_t vertexCount() const { return points ? pointCount : 8u; }
+};
+
+LocalShape placeShape(const TerrainContactShape& s, const Vec3f& centre, const Quatf& rot) {
+  LocalShape l{centre, rot.toRotationMatrix(), Vec3f::Zero(), {}, nullptr, 0};
+  switch (s.kind) {
+    case TerrainContactShape::Kind::Sphere:
+      l.halfBounds = Vec3f::Constant(s.radius);
+      break;
+    case TerrainContactShape::Kind::Capsule:
+      l.halfBounds = (l.rot.col(1) * s.halfHeight).cwiseAbs() + Vec3f::Constant(s.radius);
+      break;
+    case TerrainContactShape::Kind::Box:
+      l.halfBounds = l.rot.cwiseAbs() * s.halfExtents;
+      for (int k = 0; k < 8; ++k) {
+        const Vec3f sgn((k & 1) ? 1.f : -1.f, (k & 2) ? 1.f : -1.f, (k & 4) ? 1.f : -1.f);
+        l.corners[k] = l.rot * s.halfExtents.cwiseProduct(sgn) + centre;
+      }
+      break;
+    case TerrainContactShape::Kind::ConvexHull: {
+      l.points = s.hullPoints;
+      l.pointCount = s.hullPointCount;
+      Vec3f m = Vec3f::Zero();
+      for (uint32_t i = 0; i < s.hullPointCount; ++i) m = m.cwiseMax((l.rot * s.hullPoints[i]).cwiseAbs());
+      l.halfBounds = m;
+      break;
+    }
+  }
+  return l;
+}
+
+/// Box/hull vs one triangle: GJK + EPA for the deepest point; for face-like contacts the
+/// shape vertices supported by the triangle instead.
+int convexTriangle(const btConvexShape& convex, const btTransform& xf, const LocalShape& shape, const Vec3f& a,
+                   const Vec3f& b, const Vec3f& c, const Vec3f& n, float spec, LocalContact* out, int maxOut) {
+  // Reject early when the whole shape is behind the face or beyond reach of its plane.
+  const float sdCentre = n.dot(shape.centre - a);
+  const float reach = shape.halfBounds.dot(n.cwiseAbs());
+  if (sdCentre + reach < 0.f || sdCentre - reach > spec) return 0;
+
+  btTriangleShape tri(toBt(a), toBt(b), toBt(c));
+  tri.setMargin(0.f);
+  btVoronoiSimplexSolver simplex;
+  btGjkEpaPenetrationDepthSolver epa;
+  btGjkPairDetector gjk(&convex, &tri, &simplex, &epa);
+  btDiscreteCollisionDetectorInterface::ClosestPointInput in;
+  in.m_transformA = xf;
+  in.m_transformB.setIdentity();
+  btPointCollector res;
+  gjk.getClosestPoints(in, res, nullptr);
+  if (!res.m_hasResult || res.m_distance > spec) return 0;
+  LocalContact gjkContact{fromBt(res.m_pointInWorld), fromBt(res.m_normalOnBInWorld), -float(res.m_distance)};
+  float deepest = gjkContact.depth;
+  if (gjkContact.normal.dot(n) < 0.f) {
+    // Normal points into the solid (shape centre behind the face): push out along the face.
+    float minSd = std::numeric_limits<float>::infinity();
+    for (uint32_t i = 0; i < shape.vertexCount(); ++i) minSd = std::min(minSd, n.dot(shape.vertex(i) - a));
+    gjkContact.normal = n;
+    gjkContact.depth = deepest = -minSd;
+  }
+  int k = 0;
+  if (gjkContact.normal.dot(n) > 0.7f) {
+    const float tol = 1e-4f * (1.f + shape.centre.cwiseAbs().maxCoeff());
+    for (uint32_t i = 0; i < shape.vertexCount() && k < maxOut; ++i) {
+      const Vec3f v = shape.vertex(i);
+      const float sd = n.dot(v - a);
+      if (sd > spec || sd < -(deepest + tol)) continue;
+      const Vec3f proj = v - sd * n;
+      if ((closestPointOnTriangle(proj, a, b, c) - proj).squaredNorm() > tol * tol) continue;
+      out[k++] = {proj, n, -sd};
+    }
+  }
+  if (k == 0) out[k++] = gjkContact;
+  return k;
+}
+
+uint32_t featureOf(const Int3& chunk, uint32_t triangle) {
+  const uint32_t c = uint32_t(chunk.x & 63) | (uint32_t(chunk.y & 63) << 6) | (uint32_t(chunk.z & 127) << 12);
+  return (c << 13) | triangle;
+}
+
+}  // namespace
+
+TerrainContactShape TerrainContactShape::sphere(const Vec3d& centre, float radius) {
+  TerrainContactShape s;
+  s.kind = Kind::Sphere;
+  s.position = centre;
+  s.radius = radius;
+  return s;
+}
+
+TerrainContactShape TerrainContactShape::capsule(const Vec3d& centre, const Quatf& rotation, float halfHeight, float radius) {
+  TerrainContactShape s;
+  s.kind = Kind::Capsule;
+  s.position = centre;
+  s.rotation = rotation;
+  s.halfHeight = halfHeight;
+  s.radius = radius;
+  return s;
+}
+
+TerrainContactShape TerrainContactShape::box(const Vec3d& centre, const Quatf& rotation, const Vec3f& halfExtents) {
+  TerrainContactShape s;
+  s.kind = Kind::Box;
+  s.position = centre;
+  s.rotation = rotation;
+  s.halfExtents = halfExtents;
+  return s;
+}
+
+TerrainContactShape TerrainContactShape::convexHull(const Vec3d& centre, const Quatf& rotation, const Vec3f* points,
+                                                    uint32_t count) {
+  if (!points || count < 4) throw InvalidInput("TerrainContactShape::convexHull: count is below 4 or points is null");
+  for (uint32_t i = 0; i < count; ++i) requireFinite(points[i], "TerrainContactShape::convexHull", "points[i]");
+  TerrainContactShape s;
+  s.kind = Kind::ConvexHull;
+  s.position = centre;
+  s.rotation = rotation;
+  s.hullPoints = points;
+  s.hullPointCount = count;
+  btConvexHullComputer hull;
+  hull.compute(&points[0].x(), int(sizeof(Vec3f)), int(count), 0.f, 0.f);
+  double vol = 0;
+  for (int f = 0; f < hull.faces.size(); ++f) {
+    const btConvexHullComputer::Edge* first = &hull.edges[hull.faces[f]];
+    const btVector3& a = hull.vertices[first->getSourceVertex()];
+    for (const btConvexHullComputer::Edge* e = first->getNextEdgeOfFace(); e != first; e = e->getNextEdgeOfFace()) {
+      const btVector3& b = hull.vertices[e->getSourceVertex()];
+      const btVector3& c = hull.vertices[e->getTargetVertex()];
+      vol += double(a.dot(b.cross(c))) / 6.0;
+    }
+  }
+  s.hullVolume = float(std::abs(vol));
+  if (!(s.hullVolume > 0.f)) throw InvalidInput("TerrainContactShape::convexHull: points are coplanar (zero volume)");
+  return s;
+}
+
+float TerrainContactShape::volume() const {
+  constexpr float pi = std::numbers::pi_v<float>;
+  switch (kind) {
+    case Kind::Sphere:
+      return 4.f / 3.f * pi * radius * radius * radius;
+    case Kind::Capsule:
+      return pi * radius * radius * (4.f / 3.f * radius + 2.f * halfHeight);
+    case Kind::Box:
+      return 8.f * halfExtents.prod();
+    case Kind::ConvexHull:
+      return hullVolume;
+  }
+  return 0.f;
+}
+
+void TerrainContactShape::validate(const char* context) const {
+  requireFinite(position, context, "shape.position");
+  requireUnitQuaternion(rotation, context, "shape.rotation");
+  switch (kind) {
+    case Kind::Sphere:
+      requireInRange(radius, 1e-6, 1e6, context, "shape.radius");
+      break;
+    case Kind::Capsule:
+      requireInRange(radius, 1e-6, 1e6, context, "shape.radius");
+      requireInRange(halfHeight, 0, 1e6, context, "shape.halfHeight");
+      break;
+    case Kind::Box:
+      for (int i = 0; i < 3; ++i) requireInRange(halfExtents[i], 1e-6, 1e6, context, "shape.halfExtents");
+      break;
+    case Kind::ConvexHull:
+      if (!hullPoints || hullPointCount < 4 || !(hullVolume > 0.f)) {
+        throw InvalidInput(std::string(context) + ": shape hull was not made by TerrainContactShape::convexHull");
+      }
+      break;
+  }
+}
+
+void dropInteriorEdgeContacts(std::vector<Contact>& out, size_t begin, const std::vector<Vec3f>& faceNormals) {
+  if (faceNormals.size() != out.size() - begin) {
+    throw InvalidInput("dropInteriorEdgeContacts: faceNormals.size() differs from the number of contacts");
+  }
+  // Decide every contact against the untouched list first, then compact.
+  thread_local std::vector<uint8_t> drop;
+  drop.assign(faceNormals.size(), 0);
+  for (size_t i = begin; i < out.size(); ++i) {
+    const Vec3f& fi = faceNormals[i - begin];
+    if (out[i].normal.dot(fi) >= 0.9999f) continue;  // a face contact: always kept
+    for (size_t j = begin; j < out.size(); ++j) {
+      const Vec3f& fj = faceNormals[j - begin];
+      if (j == i || out[j].normal.dot(fj) < 0.9999f || fi.dot(fj) < 0.9999f) continue;
+      const double gap = fj.cast<double>().dot(out[i].position - out[j].position);
+      if (std::abs(gap) < 1e-4 * (1.0 + std::abs(double(out[i].depth)))) {
+        drop[i - begin] = 1;
+        break;
+      }
+    }
+  }
+  size_t w = begin;
+  for (size_t i = begin; i < out.size(); ++i) {
+    if (!drop[i - begin]) out[w++] = out[i];
+  }
+  out.resize(w);
+}
+
+size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float spec, std::vector<Contact>& out) {
+  shape.validate("terrainContacts");
+  requireInRange(spec, 0.0, 1e6, "terrainContacts", "speculativeDistance");
+  const size_t before = out.size();
+  // Face normal (world) of the triangle behind each contact appended by this call.
+  // note: thread_local scratch, so steady-state queries do not allocate.
+  thread_local std::vector<Vec3f> faceNormals;
+  faceNormals.clear();
+  const RigidTransform& place = terrain.placement();
+  const LocalShape inTerrain = placeShape(shape, place.pointToLocal(shape.position), place.rotationToLocal(shape.rotation));
+  const Aabb terrainBox = Aabb::fromCenterHalf(inTerrain.centre, inTerrain.halfBounds).expanded(spec);
+  VoxelRange range;
+  if (!terrain.broadphase().voxelRangeOf(terrainBox, terrain.voxelSize(), range)) return 0;
+
+  // Bullet shapes are made once per query; only the triangle changes per pair.
+  btBoxShape btBox(toBt(shape.halfExtents.cwiseMax(Vec3f::Constant(1e-6f))));
+  btBox.setMargin(0.f);
+  btConvexHullShape btHull;
+  if (shape.kind == TerrainContactShape::Kind::ConvexHull) {
+    for (uint32_t i = 0; i < shape.hullPointCount; ++i) btHull.addPoint(toBt(shape.hullPoints[i]), false);
+    btHull.recalcLocalAabb();
+    btHull.setMargin(0.f);
+  }
+
+  terrain.broadphase().forEachTouchedChunk(range, [&](const Int3& chunk, const TerrainOverlap& o) {
+    if (!o.solid || terrain.broadphase().kind(chunk) != ChunkMaskKind::Masked) return;
+    const ChunkCollision& cc = terrain.chunkCollision(chunk);
+    if (cc.mesh.triangleCount() == 0) return;
+    const RigidTransform xf = terrain.chunkTransform(chunk);
+    const Quatf localRot = xf.rotationToLocal(shape.rotation);
+    const LocalShape ls = placeShape(shape, xf.pointToLocal(shape.position), localRot);
+    const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds).expanded(spec);
+    btTransform btXf(btQuaternion(localRot.x(), localRot.y(), localRot.z(), localRot.w()), toBt(ls.centre));
+    const TriangleMeshView mesh = cc.mesh.view();
+    cc.tree.queryAabb(mesh, box, [&](uint32_t t) {
+      Vec3f a, b, c;
+      mesh.corners(t, a, b, c);
+      const Vec3f cr = (b - a).cross(c - a);
+      const float len = cr.norm();
+      if (!(len > 0.f)) return;
+      const Vec3f n = cr / len;
+      LocalContact lc[8];
+      int k = 0;
+      switch (shape.kind) {
+        case TerrainContactShape::Kind::Sphere:
+          k = sphereTriangle(ls.centre, shape.radius, a, b, c, n, spec, lc[0]) ? 1 : 0;
+          break;
+        case TerrainContactShape::Kind::Capsule: {
+          const Vec3f axis = ls.rot.col(1) * shape.halfHeight;
+          LocalContact two[2];
+          k = capsuleTriangle(ls.centre - axis, ls.centre + axis, shape.radius, a, b, c, n, spec, two);
+          std::copy(two, two + k, lc);
+          break;
+        }
+        case TerrainContactShape::Kind::Box:
+          k = convexTriangle(btBox, btXf, ls, a, b, c, n, spec, lc, 8);
+          break;
+        case TerrainContactShape::Kind::ConvexHull:
+          k = convexTriangle(btHull, btXf, ls, a, b, c, n, spec, lc, 8);
+          break;
+      }
+      for (int i = 0; i < k; ++i) {
+        out.push_back({xf.pointToWorld(lc[i].point), xf.directionToWorld(lc[i].normal), lc[i].depth, featureOf(chunk, t),
+                       cc.mesh.materials[t]});
+        faceNormals.push_back(xf.directionToWorld(n));
+      }
+    });
+  });
+  dropInteriorEdgeContacts(out, before, faceNormals);
+  // A point shared by several triangles (quad diagonals, corners) is reported by each: keep
+  // one. Done after the interior-edge filter, which needs every triangle's face normal.
+  size_t w = before;
+  for (size_t i = before; i < out.size(); ++i) {
+    bool duplicate = false;
+    for (size_t j = before; j < w && !duplicate; ++j) {
+      duplicate = (out[j].position - out[i].position).squaredNorm() < 1e-10 && out[j].normal.dot(out[i].normal) > 0.9999f;
+    }
+    if (!duplicate) out[w++] = out[i];
+  }
+  out.resize(w);
+  return out.size() - before;
+}
+
+bool terrainWaterContact(const Terrain& terrain, const TerrainContactShape& shape, WaterContact& out) {
+  shape.validate("terrainWaterContact");
+  out = {};
+  const RigidTransform& place = terrain.placement();
+  const LocalShape ls = placeShape(shape, place.pointToLocal(shape.position), place.rotationToLocal(shape.rotation));
+  const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds);
+  if (!terrain.overlapLocal(box).water) return false;
+  const float vs = terrain.voxelSize();
+  const Int3 size = terrain.voxels().size();
+  int lo[3], hi[3];
+  for (int i = 0; i < 3; ++i) {
+    const int n = (&size.x)[i];
+    lo[i] = int(std::clamp(std::floor(double(box.min[i]) / vs), 0.0, double(n - 1)));
+    hi[i] = int(std::clamp(std::floor(double(box.max[i]) / vs), 0.0, double(n - 1)));
+  }
+  double volume = 0;
+  Vec3d moment = Vec3d::Zero();
+  for (int y = lo[1]; y <= hi[1]; ++y)
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int x = lo[0]; x <= hi[0]; ++x) {
+        const Voxel v = terrain.voxels().get({x, y, z});
+        if (!v.isWater()) continue;
+        // The filled part of the cell: occupancy/255 of its height, from the bottom.
+        const Vec3f cellMin(float(x) * vs, float(y) * vs, float(z) * vs);
+        const Vec3f cellMax(cellMin.x() + vs, cellMin.y() + vs * float(v.occupancy) / 255.f, cellMin.z() + vs);
+        const Vec3f omin = cellMin.cwiseMax(box.min), omax = cellMax.cwiseMin(box.max);
+        if ((omin.array() >= omax.array()).any()) continue;
+        const double ov = double((omax - omin).prod());
+        volume += ov;
+        moment += ov * ((omin + omax) * 0.5f).cast<double>();
+      }
+  if (volume <= 0) return false;
+  const double boxVolume = double(box.volume());
+  const double scale = boxVolume > 0 ? double(shape.volume()) / boxVolume : 0.0;
+  out.submergedVolume = volume * scale;
+  out.submergedFraction = float(std::min(1.0, volume / boxVolume));
+  out.centreOfBuoyancy = place.pointToWorld((moment / volume).cast<float>());
+  return true;
+}
+
+}  // namespace bw

@@ -1,0 +1,251 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "collision/input_validation.h"
+#include "collision/terrain/chunk_mesher.h"
+#include "collision/terrain/terrain_contacts.h"
+#include "collision/terrain/triangle_contacts.h"
+#include "collision/terrain/terrain_generator.h"
+
+namespace bw {
+namespace {
+
+/// A flat solid floor whose top surface is at y = 4 (terrain-local).
+std::unique_ptr<Terrain> flatTerrain(const RigidTransform& place = {}) {
+  auto t = std::make_unique<Terrain>(Int3{32, 16, 32}, 1.f, place);
+  t->fillBox({0, 0, 0}, {31, 3, 31}, Voxel::make(7));
+  return t;
+}
+
+TEST(TerrainContacts, SphereContactsMatchBruteForceOverAllTriangles) {
+  Terrain terrain({32, 20, 32}, 1.f);
+  terrain.edit({0, 0, 0}, {31, 19, 31}, [](VoxelTerrain& v) { generateRandomTerrain(v, 51, 0.03f); });
+  // Brute force: every triangle of every chunk, terrain-local, same per-triangle primitive.
+  std::vector<Vec3f> tris;
+  ChunkNeighbourhood n;
+  ChunkMesh mesh;
+  for (int cy = 0; cy < 3; ++cy)
+    for (int cz = 0; cz < 4; ++cz)
+      for (int cx = 0; cx < 4; ++cx) {
+        terrain.voxels().gatherNeighbourhood({cx, cy, cz}, n);
+        meshChunk(n, 1.f, mesh);
+        for (uint16_t i : mesh.indices) tris.push_back(mesh.vertex(i) + Vec3f(float(cx * 8), float(cy * 8), float(cz * 8)));
+      }
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> pos(-2.f, 34.f), rad(0.2f, 2.5f);
+  std::vector<Contact> contacts;
+  size_t total = 0;
+  for (int q = 0; q < 300; ++q) {
+    const Vec3f c(pos(rng), pos(rng) * 0.6f, pos(rng));
+    const float r = rad(rng);
+    std::vector<Contact> brute;
+    std::vector<Vec3f> faces;
+    for (size_t t = 0; t < tris.size(); t += 3) {
+      const Vec3f nrm = (tris[t + 1] - tris[t]).cross(tris[t + 2] - tris[t]).normalized();
+      LocalContact lc;
+      if (sphereTriangle(c, r, tris[t], tris[t + 1], tris[t + 2], nrm, 0.05f, lc)) {
+        brute.push_back({lc.point.cast<double>(), lc.normal, lc.depth, 0, 0});
+        faces.push_back(nrm);
+      }
+    }
+    dropInteriorEdgeContacts(brute, 0, faces);
+    std::vector<float> want;
+    for (const Contact& k : brute) want.push_back(k.depth);
+    contacts.clear();
+    terrainContacts(terrain, TerrainContactShape::sphere(c.cast<double>(), r), 0.05f, contacts);
+    std::vector<float> got;
+    for (const Contact& k : contacts) got.push_back(k.depth);
+    // Duplicate points are merged by terrainContacts; compare the distinct depths and counts.
+    ASSERT_LE(got.size(), want.size()) << q;
+    std::sort(got.begin(), got.end());
+    std::sort(want.begin(), want.end());
+    if (!want.empty()) {
+      ASSERT_FALSE(got.empty()) << q;
+      EXPECT_NEAR(got.back(), want.back(), 1e-4f) << q;
+    }
+    for (float d : want) {
+      const bool present = std::any_of(got.begin(), got.end(), [&](float g) { return std::abs(g - d) < 1e-4f; });
+      ASSERT_TRUE(present) << "query " << q << " lost a contact of depth " << d;
+    }
+    total += got.size();
+  }
+  EXPECT_GT(total, 100u);
+}
+
+TEST(TerrainContacts, SphereOnFlatGroundFarFromOriginAndRotated) {
+  const RigidTransform place{Vec3d(3.0e7, 1.0e6, -2.0e7), Quatf(Eigen::AngleAxisf(0.4f, Vec3f(1, 0.5f, 0).normalized()))};
+  for (const RigidTransform& p : {RigidTransform{}, place}) {
+    const auto holder = flatTerrain(p);
+    Terrain& terrain = *holder;
+    const Vec3d localCentre(10.3, 4.0 + 0.5 - 0.1, 12.6);
+    const Vec3d centre = p.translation + p.rotation.cast<double>() * localCentre;
+    std::vector<Contact> contacts;
+    ASSERT_EQ(terrainContacts(terrain, TerrainContactShape::sphere(centre, 0.5f), 0.f, contacts), 1u);
+    const Contact& c = contacts[0];
+    EXPECT_NEAR(c.depth, 0.1f, 1e-4f);
+    EXPECT_LT((c.normal - p.directionToWorld(Vec3f(0, 1, 0))).norm(), 1e-5f);
+    const Vec3d expect = p.translation + p.rotation.cast<double>() * Vec3d(10.3, 4.0, 12.6);
+    EXPECT_LT((c.position - expect).norm(), 1e-4);
+    EXPECT_EQ(c.material, 7u);
+    // Deep: centre 0.2 below the surface, still pushed up along the face normal.
+    contacts.clear();
+    const Vec3d deep = p.translation + p.rotation.cast<double>() * Vec3d(10.3, 3.8, 12.6);
+    ASSERT_GE(terrainContacts(terrain, TerrainContactShape::sphere(deep, 0.5f), 0.f, contacts), 1u);
+    EXPECT_NEAR(contacts[0].depth, 0.7f, 1e-4f);
+    EXPECT_LT((contacts[0].normal - p.directionToWorld(Vec3f(0, 1, 0))).norm(), 1e-5f);
+  }
+}
+
+TEST(TerrainContacts, ShapesAcrossChunkBordersGetOneConsistentManifold) {
+  const auto holder = flatTerrain();
+  Terrain& terrain = *holder;
+  std::vector<Contact> contacts;
+  // A sphere right above the corner shared by four chunks (x = z = 8): the four chunks' quads
+  // all touch it at the same point; exactly one contact survives, along the face normal.
+  terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(8, 4.4, 8), 0.5f), 0.f, contacts);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_NEAR(contacts[0].depth, 0.1f, 1e-5f);
+  EXPECT_GT(contacts[0].normal.y(), 0.99999f);
+  // A box straddling the x = 16 border: its four corners, nothing tilted.
+  contacts.clear();
+  terrainContacts(terrain, TerrainContactShape::box(Vec3d(16.1, 4.45, 5.3), Quatf::Identity(), Vec3f(0.7f, 0.5f, 0.4f)), 0.f, contacts);
+  int corners = 0;
+  for (const Contact& c : contacts) {
+    EXPECT_GT(c.normal.y(), 0.999f);
+    EXPECT_NEAR(c.depth, 0.05f, 1e-3f);
+    corners += std::abs(std::abs(c.position.x() - 16.1) - 0.7) < 1e-4 && std::abs(std::abs(c.position.z() - 5.3) - 0.4) < 1e-4;
+  }
+  EXPECT_EQ(corners, 4);
+}
+
+TEST(TerrainContacts, SphereOnAStepEdgeGetsADiagonalNormal) {
+  const auto holder = flatTerrain();
+  Terrain& terrain = *holder;
+  terrain.fillBox({0, 4, 0}, {9, 4, 31}, Voxel::make(3));  // a step up to y = 5 for x < 10
+  std::vector<Contact> contacts;
+  // Centre beyond the step's edge line (x = 10, y = 5), diagonally out, 0.05 penetrating.
+  const double off = (0.5 - 0.05) / std::sqrt(2.0);
+  terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(10 + off, 5 + off, 15.5), 0.5f), 0.f, contacts);
+  ASSERT_FALSE(contacts.empty());
+  float deepest = 0.f;
+  for (const Contact& c : contacts) deepest = std::max(deepest, c.depth);
+  EXPECT_NEAR(deepest, 0.05f, 1e-4f);
+  EXPECT_NEAR(contacts[0].normal.x(), std::sqrt(0.5f), 1e-3f);
+  EXPECT_NEAR(contacts[0].normal.y(), std::sqrt(0.5f), 1e-3f);
+}
+
+TEST(TerrainContacts, BoxRestingOnGroundIsSupportedAtItsFourCorners) {
+  const auto holder = flatTerrain();
+  Terrain& terrain = *holder;
+  std::vector<Contact> contacts;
+  terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.5 - 0.05, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)), 0.f,
+                  contacts);
+  ASSERT_GE(contacts.size(), 4u);
+  int corners = 0;
+  for (const Contact& c : contacts) {
+    EXPECT_NEAR(c.depth, 0.05f, 1e-3f);
+    EXPECT_GT(c.normal.dot(Vec3f(0, 1, 0)), 0.999f);
+    EXPECT_NEAR(c.position.y(), 4.0, 1e-4);
+    const bool corner = std::abs(std::abs(c.position.x() - 10.3) - 0.5) < 1e-4 && std::abs(std::abs(c.position.z() - 10.4) - 0.5) < 1e-4;
+    corners += corner;
+  }
+  EXPECT_EQ(corners, 4);
+  // A box tilted 45 degrees about Z lands on an edge: its lowest edge penetrates by 0.05.
+  contacts.clear();
+  const Quatf tilt(Eigen::AngleAxisf(float(M_PI / 4), Vec3f::UnitZ()));
+  const double h = 0.5 * std::sqrt(2.0);
+  terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.0 + h - 0.05, 10.4), tilt, Vec3f(0.5f, 0.5f, 0.5f)), 0.f, contacts);
+  ASSERT_FALSE(contacts.empty());
+  float deepest = 0.f;
+  for (const Contact& c : contacts) deepest = std::max(deepest, c.depth);
+  EXPECT_NEAR(deepest, 0.05f, 1e-3f);
+  // Out of reach: nothing; within the speculative distance: negative depth.
+  contacts.clear();
+  EXPECT_EQ(terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.6, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)), 0.f,
+                            contacts),
+            0u);
+  EXPECT_GE(terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.6, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)),
+                            0.2f, contacts),
+            1u);
+  EXPECT_NEAR(contacts[0].depth, -0.1f, 1e-3f);
+}
+
+TEST(TerrainContacts, CapsuleLyingFlatTouchesAtBothEnds) {
+  const auto holder = flatTerrain();
+  Terrain& terrain = *holder;
+  std::vector<Contact> contacts;
+  const Quatf lying(Eigen::AngleAxisf(float(M_PI / 2), Vec3f::UnitZ()));  // core along X
+  terrainContacts(terrain, TerrainContactShape::capsule(Vec3d(12.2, 4.0 + 0.3 - 0.02, 9.7), lying, 1.0f, 0.3f), 0.f, contacts);
+  ASSERT_GE(contacts.size(), 2u);
+  bool left = false, right = false;
+  for (const Contact& c : contacts) {
+    EXPECT_NEAR(c.depth, 0.02f, 1e-4f);
+    left |= std::abs(c.position.x() - 11.2) < 1e-4;
+    right |= std::abs(c.position.x() - 13.2) < 1e-4;
+  }
+  EXPECT_TRUE(left && right);
+}
+
+TEST(TerrainContacts, ConvexHullAgreesWithTheEquivalentBox) {
+  const auto holder = flatTerrain();
+  Terrain& terrain = *holder;
+  const std::vector<Vec3f> pts = {{-0.4f, -0.3f, -0.2f}, {0.4f, -0.3f, -0.2f}, {-0.4f, 0.3f, -0.2f}, {0.4f, 0.3f, -0.2f},
+                                  {-0.4f, -0.3f, 0.2f},  {0.4f, -0.3f, 0.2f},  {-0.4f, 0.3f, 0.2f},  {0.4f, 0.3f, 0.2f},
+                                  {0.f, 0.f, 0.f}};
+  const TerrainContactShape hull = TerrainContactShape::convexHull(Vec3d(5.5, 4.25, 6.5), Quatf::Identity(), pts.data(), uint32_t(pts.size()));
+  EXPECT_NEAR(hull.volume(), 0.8f * 0.6f * 0.4f, 1e-5f);
+  std::vector<Contact> h, b;
+  terrainContacts(terrain, hull, 0.f, h);
+  terrainContacts(terrain, TerrainContactShape::box(Vec3d(5.5, 4.25, 6.5), Quatf::Identity(), Vec3f(0.4f, 0.3f, 0.2f)), 0.f, b);
+  ASSERT_FALSE(h.empty());
+  ASSERT_EQ(h.size(), b.size());
+  for (size_t i = 0; i < h.size(); ++i) {
+    EXPECT_NEAR(h[i].depth, b[i].depth, 1e-4f);
+    EXPECT_NEAR(h[i].depth, 0.05f, 1e-4f);
+  }
+  EXPECT_THROW(TerrainContactShape::convexHull(Vec3d::Zero(), Quatf::Identity(), pts.data(), 3), InvalidInput);
+}
+
+TEST(TerrainContacts, WaterGivesSubmergedVolumeForBuoyancy) {
+  Terrain terrain({32, 16, 32}, 1.f);
+  terrain.fillBox({0, 0, 0}, {31, 3, 31}, Voxel::make(7));
+  terrain.fillBox({0, 4, 0}, {31, 7, 31}, Voxel::make(kMaterialWater));  // water surface at y = 8
+  WaterContact w;
+  // Box with half its height under the surface.
+  const TerrainContactShape box = TerrainContactShape::box(Vec3d(10, 8, 10), Quatf::Identity(), Vec3f(1, 0.5f, 1));
+  ASSERT_TRUE(terrainWaterContact(terrain, box, w));
+  EXPECT_NEAR(w.submergedVolume, 2.0, 1e-4);
+  EXPECT_NEAR(w.submergedFraction, 0.5f, 1e-5f);
+  EXPECT_NEAR(w.centreOfBuoyancy.y(), 7.75, 1e-4);
+  // Fully submerged sphere: the whole volume.
+  ASSERT_TRUE(terrainWaterContact(terrain, TerrainContactShape::sphere(Vec3d(10, 6, 10), 0.7f), w));
+  EXPECT_NEAR(w.submergedVolume, 4.0 / 3.0 * M_PI * 0.343, 1e-3);
+  EXPECT_NEAR(w.submergedFraction, 1.f, 1e-6f);
+  // Partly filled water cells (occupancy 51/255 = 0.2 of a cell): water ends at y = 7.2.
+  terrain.fillBox({0, 7, 0}, {31, 7, 31}, Voxel::make(kMaterialWater, 51));
+  const TerrainContactShape low = TerrainContactShape::box(Vec3d(10, 7.4, 10), Quatf::Identity(), Vec3f(1, 0.5f, 1));
+  ASSERT_TRUE(terrainWaterContact(terrain, low, w));
+  EXPECT_NEAR(w.submergedVolume, 4.0 * 0.3, 1e-4);  // from y = 6.9 to 7.2
+  EXPECT_FALSE(terrainWaterContact(terrain, box, w));  // box bottom 7.5 is above the water
+  // In the air above the water: nothing.
+  EXPECT_FALSE(terrainWaterContact(terrain, TerrainContactShape::sphere(Vec3d(10, 13, 10), 0.5f), w));
+}
+
+TEST(TerrainContacts, RejectsInvalidShapes) {
+  const auto holder = flatTerrain();
+  Terrain& terrain = *holder;
+  std::vector<Contact> contacts;
+  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(NAN, 0, 0), 1.f), 0.f, contacts), InvalidInput);
+  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(0, 0, 0), -1.f), 0.f, contacts), InvalidInput);
+  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::box(Vec3d(0, 0, 0), Quatf(2, 0, 0, 0), Vec3f(1, 1, 1)), 0.f, contacts),
+               InvalidInput);
+  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(0, 0, 0), 1.f), NAN, contacts), InvalidInput);
+}
+
+}  // namespace
+}  // namespace bw
