@@ -25,6 +25,10 @@ constexpr float kRestitution = 0.1f;
 constexpr float kBounceThreshold = 1.0f;
 // Sleeping: an island whose bodies all stayed below these speeds for kSleepTime seconds sleeps.
 constexpr float kSleepLinear = 0.05f, kSleepAngular = 0.1f, kSleepTime = 0.5f;
+// Pair cache: contacts are reused while the relative pose moved less than these since they were
+// made (a resting pile moves micrometres per step).
+constexpr double kReuseTranslation = 1e-3;
+constexpr float kReuseRotation = 1e-3f;  // radians
 
 void primitiveMass(const QueryShape& s, float density, float& invMass, Vec3f& invInertia) {
   float m;
@@ -197,6 +201,13 @@ void World::generateContacts(float dt) {
       (ga.brickCount() <= gb.brickCount() ? ga : gb).convexApproximation(scene_.settings.approximationDepth);
     }
   }
+  // Pair cache lookup (both lists are sorted by pair): a hit reuses last contacts if the
+  // relative pose has barely moved.
+  pairCacheHit_.assign(n, -1);
+  for (uint32_t k = 0, c = 0; k < n; ++k) {
+    while (c < pairCache_.size() && pairCache_[c].pair < pairs_[k]) ++c;
+    if (c < pairCache_.size() && pairCache_[c].pair == pairs_[k]) pairCacheHit_[k] = int32_t(c);
+  }
   // Each pair writes only its own slot: the result does not depend on the thread count.
   jobs_.parallelFor(0, n, 4, [&](uint32_t begin, uint32_t end) {
     ProfileZone zone(profiler_, "contacts", stage_ + 1);
@@ -205,6 +216,28 @@ void World::generateContacts(float dt) {
       out.clear();
       uint32_t a = pairs_[k].a, b = pairs_[k].b;
       if (!canCollide(a, b) || (!active(a) && !active(b))) continue;  // nothing awake: nothing to do
+      const RigidTransform poseA{bodies_.position[a], bodies_.rotation[a]}, poseB{bodies_.position[b], bodies_.rotation[b]};
+      if (pairCacheHit_[k] >= 0) {
+        const PairCacheEntry& e = pairCache_[size_t(pairCacheHit_[k])];
+        const RigidTransform rel = poseA.inverse() * poseB;
+        const bool still = (rel.translation - e.relative.translation).norm() < kReuseTranslation &&
+                           e.relative.rotation.angularDistance(rel.rotation) < kReuseRotation;
+        if (still) {
+          // Re-pose the cached points and measure the depth along the normal again.
+          for (uint32_t i = 0; i < e.count; ++i) {
+            const CachedContact& c = pairCacheContacts_[e.first + i];
+            const Vec3d onA = poseA.pointToWorld(c.onA), onB = poseB.pointToWorld(c.onB);
+            const Vec3f nrm = poseB.directionToWorld(c.normalB);
+            // The slot's normal points from its "b side" towards its "a side" (flipped swaps them).
+            const float depth = e.flipped ? float((onA - onB).dot(nrm.cast<double>())) : float((onB - onA).dot(nrm.cast<double>()));
+            // The slot's point lies on the surface its normal leaves: b's (or a's when flipped).
+            out.push_back({e.flipped ? onA : onB, nrm, depth, c.feature, c.material});
+          }
+          pairFlipped_[k] = e.flipped;
+          pairStats_[k].rawContacts = uint32_t(-1);  // marks a reuse for the stats
+          continue;
+        }
+      }
       // Speculative contacts: look as far ahead as the pair can close in one step, so fast
       // bodies meet thin plates before they pass them (the solver lets gaps close, not cross).
       ContactParams params = base;
@@ -233,6 +266,31 @@ void World::generateContacts(float dt) {
       }
     }
   });
+}
+
+// Stores every pair's contacts in both bodies' frames for the next step.
+void World::updatePairCache() {
+  nextPairCache_.clear();
+  nextPairCacheContacts_.clear();
+  for (uint32_t k = 0; k < pairs_.size(); ++k) {
+    if (pairContacts_[k].empty()) continue;
+    const uint32_t a = pairs_[k].a, b = pairs_[k].b;
+    const RigidTransform poseA{bodies_.position[a], bodies_.rotation[a]}, poseB{bodies_.position[b], bodies_.rotation[b]};
+    PairCacheEntry e{pairs_[k], poseA.inverse() * poseB, pairFlipped_[k], uint32_t(nextPairCacheContacts_.size()),
+                     uint32_t(pairContacts_[k].size())};
+    // A reused entry keeps its original relative pose, so slow creep is caught once it adds up.
+    if (pairCacheHit_[k] >= 0 && pairStats_[k].rawContacts == uint32_t(-1)) e.relative = pairCache_[size_t(pairCacheHit_[k])].relative;
+    for (const Contact& c : pairContacts_[k]) {
+      // The point lies on the slot's "b side" surface; the "a side" point is depth along -normal.
+      const Vec3d onSideB = c.position, onSideA = c.position - c.normal.cast<double>() * double(c.depth);
+      const Vec3d onB = pairFlipped_[k] ? onSideA : onSideB, onA = pairFlipped_[k] ? onSideB : onSideA;
+      nextPairCacheContacts_.push_back({poseA.pointToLocal(onA), poseB.pointToLocal(onB), poseB.directionToLocal(c.normal), c.featureB,
+                                        c.material});
+    }
+    nextPairCache_.push_back(e);
+  }
+  std::swap(pairCache_, nextPairCache_);
+  std::swap(pairCacheContacts_, nextPairCacheContacts_);
 }
 
 void World::prepareSolver(float dt) {
@@ -459,6 +517,7 @@ void World::substep(float dt, int index) {
   {
     ProfileZone z(profiler_, "contacts (stage)");
     generateContacts(dt);
+    updatePairCache();
   }
   stats_.contactsMs += msSince(t);
   t = Clock::now();
@@ -482,6 +541,10 @@ void World::substep(float dt, int index) {
   stats_.pairs += uint32_t(pairs_.size());
   stats_.contacts += uint32_t(contacts_.size());
   for (const ContactStats& s : pairStats_) {
+    if (s.rawContacts == uint32_t(-1)) {
+      ++stats_.pairsReused;
+      continue;
+    }
     stats_.boxTests += s.index.boxTests;
     stats_.narrowphase += s.bricksTested;
   }

@@ -100,7 +100,7 @@ int runScene(const SceneRunOptions& o) {
   const uint32_t frames = o.frames ? o.frames : scene.settings.frames;
 
   Series total, broad, contacts, solver, integrate;
-  uint64_t pairs = 0, contactCount = 0, boxTests = 0;
+  uint64_t pairs = 0, contactCount = 0, boxTests = 0, reused = 0;
   std::ofstream csv;
   if (!o.csvPath.empty()) {
     csv.open(o.csvPath);
@@ -120,6 +120,7 @@ int runScene(const SceneRunOptions& o) {
     pairs += s.pairs;
     contactCount += s.contacts;
     boxTests += s.boxTests;
+    reused += s.pairsReused;
     if (csv) csv << f << "," << s.totalMs << "," << s.broadphaseMs << "," << s.contactsMs << "," << s.solverMs << ","
                  << s.integrateMs << "," << s.pairs << "," << s.contacts << "," << s.boxTests << "\n";
     if (o.progress && !o.json && frames >= 100 && (f + 1) % (frames / 10) == 0)
@@ -159,6 +160,7 @@ int runScene(const SceneRunOptions& o) {
                      {"solver", stage(solver)},
                      {"integrate", stage(integrate)},
                      {"pairs_per_frame", double(pairs) / frames},
+                     {"pairs_reused_per_frame", double(reused) / frames},
                      {"contacts_per_frame", double(contactCount) / frames},
                      {"box_tests_per_frame", double(boxTests) / frames},
                      {"peak_resident_mib", peakResidentMiB()},
@@ -183,8 +185,8 @@ int runScene(const SceneRunOptions& o) {
   for (auto [name, s] : {std::pair<const char*, const Series*>{"frame", &total}, {"broadphase", &broad}, {"contacts", &contacts},
                          {"solver", &solver}, {"integrate", &integrate}})
     std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
-  std::printf("  per frame: %.0f pairs, %.0f contacts, %.0f box tests\n", double(pairs) / frames, double(contactCount) / frames,
-              double(boxTests) / frames);
+  std::printf("  per frame: %.0f pairs (%.0f reused from the pair cache), %.0f contacts, %.0f box tests\n", double(pairs) / frames,
+              double(reused) / frames, double(contactCount) / frames, double(boxTests) / frames);
   std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
               world.sleepingCount(), moving, std::isfinite(lowest) ? lowest : 0.0);
   std::printf("  peak memory %.0f MiB; state hash %016llx\n", peakResidentMiB(), (unsigned long long)world.stateHash());
