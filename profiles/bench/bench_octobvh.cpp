@@ -420,7 +420,8 @@ void printSummary() {
 
 BENCHMARK(Load_OctoBVH)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(Load_LooseOctree)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(Load_btDbvt)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+// btDbvt stops at 1M: its incremental load is superlinear here (1M took 48 s, 4M did not finish in 5 min).
+BENCHMARK(Load_btDbvt)->Arg(100'000)->Arg(1'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_OctoBVH)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_LooseOctree)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_btDbvt)->Iterations(3)->Unit(benchmark::kMillisecond);
