@@ -1,0 +1,77 @@
+#include "render_batch/render_frame_pipeline.h"
+
+#include <chrono>
+
+#include "render_batch/concurrent_command_queue.h"
+#include "render_batch/mutex_command_queue.h"
+
+namespace bw {
+namespace {
+
+std::unique_ptr<CommandQueue> makeQueue(SubmissionMode mode, const AttachmentStore& store) {
+  if (mode == SubmissionMode::PerObjectConcurrent) return std::make_unique<ConcurrentCommandQueue>();
+  // note: the per-object mutex queue is reserved for a full frame of commands so that the
+  // comparison measures locking, not vector growth.
+  const size_t expected = mode == SubmissionMode::PerObjectMutex ? store.primitiveCount() + 2u * store.lightCount() + 1 : 4;
+  return std::make_unique<MutexCommandQueue>(expected);
+}
+
+double msSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+RenderFramePipeline::RenderFramePipeline(AttachmentStore& store, SubmissionMode mode,
+                                         RenderThread::FenceObserver observer, uint32_t batchPrimitiveCapacity,
+                                         uint32_t batchLightCapacity)
+    : store_(store), mode_(mode) {
+  render_ = std::make_unique<RenderThread>(RenderScene(store.primitiveCount(), store.lightAttenuationRadii()),
+                                           makeQueue(mode, store), std::move(observer));
+  if (mode == SubmissionMode::Batched)
+    batched_ = std::make_unique<BatchedSubmitter>(
+        *render_, batchPrimitiveCapacity == UINT32_MAX ? store.primitiveCount() : batchPrimitiveCapacity,
+        batchLightCapacity == UINT32_MAX ? store.lightCount() : batchLightCapacity);
+  else
+    perObject_ = std::make_unique<PerObjectSubmitter>(*render_);
+}
+
+RenderFramePipeline::~RenderFramePipeline() {
+  // note: the render thread may still read a batch; stop it before the submitter goes away.
+  render_.reset();
+}
+
+FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, JobSystem& jobs) {
+  return runFrame(bodies, [&jobs](TransformUpdate& update) { update.run(jobs); });
+}
+
+FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const UpdateRunner& runner) {
+  FrameTiming timing;
+  const uint64_t frame = frame_ + 1;
+  const auto waitStart = std::chrono::steady_clock::now();
+  if (frame >= 3) render_->waitForFrame(frame - 2);
+  timing.waitMs = msSince(waitStart);
+  const auto start = std::chrono::steady_clock::now();
+  // note: frame_ advances just before the commit, which always signals the fence (even when
+  // it then throws on overflow); a throwing update leaves frame_ unchanged and nothing fenced.
+  if (batched_) {
+    batched_->beginFrame(frame);
+    TransformUpdate update(store_, bodies, *batched_);
+    runner(update);
+    frame_ = frame;
+    batched_->commitFrame(frame);
+  } else {
+    TransformUpdate update(store_, bodies, *perObject_);
+    runner(update);
+    frame_ = frame;
+    perObject_->commitFrame(frame);
+  }
+  timing.gameMs = msSince(start);
+  return timing;
+}
+
+void RenderFramePipeline::finish() {
+  if (frame_ != 0) render_->waitForFrame(frame_);
+}
+
+}  // namespace bw

@@ -1,0 +1,64 @@
+#pragma once
+/// One game-side frame of the render path: transform update, submission in a chosen mode, commit.
+///
+///   RenderFramePipeline pipeline(store, SubmissionMode::Batched);
+///   for (...) { bodies.step(f, 1.f); pipeline.runFrame(bodies.view(), jobs); }
+///   pipeline.finish();    // waits for the last frame; the render scene is then readable
+///
+/// Frames in flight: frame N starts only after frame N-2's fence, so the render thread applies
+/// frame N-1 while the game computes frame N (DESIGN.md frame step 7) and never falls further behind.
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "jobs/job_system.h"
+#include "render_batch/batched_submitter.h"
+#include "render_batch/per_object_submitter.h"
+#include "render_batch/render_thread.h"
+#include "render_batch/submission_mode.h"
+#include "transforms/attachment_store.h"
+#include "transforms/transform_update.h"
+
+namespace bw {
+
+/// Game-thread time of one frame.
+struct FrameTiming {
+  double gameMs = 0;  ///< transform update + submission + commit on the game thread
+  double waitMs = 0;  ///< time blocked on the render thread before the frame could start
+};
+
+/// Drives frames for one store in one submission mode (see file comment).
+class RenderFramePipeline {
+ public:
+  /// Runs a transform update (on the job system, on the caller's own threads, ...).
+  using UpdateRunner = std::function<void(TransformUpdate&)>;
+
+  /// Render scene sized from store; batches sized from the store unless capacities are given.
+  RenderFramePipeline(AttachmentStore& store, SubmissionMode mode, RenderThread::FenceObserver observer = {},
+                      uint32_t batchPrimitiveCapacity = UINT32_MAX, uint32_t batchLightCapacity = UINT32_MAX);
+  ~RenderFramePipeline();
+
+  /// Runs the next frame with the update on jobs.
+  FrameTiming runFrame(const BodyPoseView& bodies, JobSystem& jobs);
+  /// Runs the next frame with the update run by runner.
+  FrameTiming runFrame(const BodyPoseView& bodies, const UpdateRunner& runner);
+  /// Waits until every submitted frame is applied.
+  void finish();
+
+  /// Last frame submitted (frames count from 1).
+  uint64_t frame() const { return frame_; }
+  /// Submission mode.
+  SubmissionMode mode() const { return mode_; }
+  /// The render thread (its scene is readable after finish()).
+  RenderThread& renderThread() { return *render_; }
+
+ private:
+  AttachmentStore& store_;
+  SubmissionMode mode_;
+  std::unique_ptr<RenderThread> render_;
+  std::unique_ptr<PerObjectSubmitter> perObject_;
+  std::unique_ptr<BatchedSubmitter> batched_;
+  uint64_t frame_ = 0;
+};
+
+}  // namespace bw

@@ -1,0 +1,123 @@
+#include "transforms/attachment_workload.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "collision/input_validation.h"
+
+namespace bw {
+namespace {
+
+/// splitmix64 finaliser: a counter-based hash, so motion is a pure function of (seed, frame, body).
+uint64_t mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+/// Uniform double in [0, 1) from 53 random bits (portable, unlike std distributions).
+double unit(uint64_t bits) { return static_cast<double>(bits >> 11) * 0x1.0p-53; }
+
+/// Uniform in [lo, hi) from a generator.
+double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * unit(rng()); }
+
+Quatf randomRotation(std::mt19937_64& rng) {
+  Quatf q(static_cast<float>(uniform(rng, -1, 1)), static_cast<float>(uniform(rng, -1, 1)),
+          static_cast<float>(uniform(rng, -1, 1)), static_cast<float>(uniform(rng, -1, 1)));
+  if (q.squaredNorm() < 1e-6f) return Quatf::Identity();
+  return q.normalized();
+}
+
+Vec3f randomVec(std::mt19937_64& rng, double lo, double hi) {
+  return Vec3f(static_cast<float>(uniform(rng, lo, hi)), static_cast<float>(uniform(rng, lo, hi)),
+               static_cast<float>(uniform(rng, lo, hi)));
+}
+
+}  // namespace
+
+BodyMotion::BodyMotion(uint32_t count, uint64_t seed, double extent, const Vec3d& offset) : seed_(seed) {
+  std::mt19937_64 rng(mix(seed ^ 0x626f646965730000ull));
+  position_.reserve(count);
+  rotation_.reserve(count);
+  velocity_.reserve(count);
+  spin_.reserve(count);
+  moved_.assign(count, 0);
+  for (uint32_t i = 0; i < count; ++i) {
+    position_.push_back(offset + Vec3d(uniform(rng, -extent, extent), uniform(rng, -extent, extent),
+                                       uniform(rng, -extent, extent)));
+    rotation_.push_back(randomRotation(rng));
+    velocity_.push_back(randomVec(rng, -0.5, 0.5));
+    const Vec3f axis = randomVec(rng, -1, 1);
+    const float angle = static_cast<float>(uniform(rng, -0.05, 0.05));
+    spin_.push_back(axis.squaredNorm() < 1e-6f ? Quatf::Identity()
+                                               : Quatf(Eigen::AngleAxisf(angle, axis.normalized())));
+  }
+}
+
+void BodyMotion::step(uint64_t frame, float movingFraction) {
+  uint32_t movedCount = 0;
+  const uint64_t frameKey = mix(seed_ ^ mix(frame));
+  for (uint32_t i = 0; i < count(); ++i) {
+    const bool move = unit(mix(frameKey + i)) < movingFraction;
+    moved_[i] = move ? 1 : 0;
+    if (!move) continue;
+    ++movedCount;
+    position_[i] += velocity_[i].cast<double>();
+    rotation_[i] = (rotation_[i] * spin_[i]).normalized();
+  }
+  movedCount_ = movedCount;
+}
+
+void BodyMotion::markAllMoved() {
+  std::fill(moved_.begin(), moved_.end(), 1);
+  movedCount_ = count();
+}
+
+AttachmentWorkload makeAttachmentWorkload(const AttachmentWorkloadDesc& desc) {
+  const char* context = "makeAttachmentWorkload";
+  if (desc.maxDepth < 1 || desc.maxDepth > kMaxAttachmentDepth)
+    throw InvalidInput(std::string(context) + ": maxDepth " + std::to_string(desc.maxDepth) + " outside 1.." +
+                       std::to_string(kMaxAttachmentDepth));
+  requireInRange(desc.lightFraction, 0, 1, context, "lightFraction");
+  requireInRange(desc.childFraction, 0, 1, context, "childFraction");
+  requireInRange(desc.worldExtent, 0, 1e12, context, "worldExtent");
+  requireFinite(desc.worldOffset, context, "worldOffset");
+
+  std::mt19937_64 rng(mix(desc.seed));
+  AttachmentStore store;
+  store.reserve(desc.attachments);
+  std::vector<uint32_t> bodyAttachments;  // attachments of the body being built
+  uint32_t bodies = 0;
+  while (store.size() < desc.attachments) {
+    const uint32_t body = bodies++;
+    bodyAttachments.clear();
+    // Every body carries a root primitive (its hull), then 0..4 more attachments.
+    const Vec3f half = randomVec(rng, 0.25, 4.0);
+    bodyAttachments.push_back(
+        store.addPrimitive(body, kNoParentAttachment, randomVec(rng, -0.5, 0.5), randomRotation(rng),
+                           Aabb::fromCenterHalf(randomVec(rng, -0.2, 0.2), half)));
+    const uint32_t extra = static_cast<uint32_t>(rng() % 5);
+    for (uint32_t k = 0; k < extra && store.size() < desc.attachments; ++k) {
+      uint32_t parent = kNoParentAttachment;
+      if (unit(rng()) < desc.childFraction) {
+        const uint32_t candidate = bodyAttachments[rng() % bodyAttachments.size()];
+        if (store.depth(candidate) + 1 < desc.maxDepth) parent = candidate;
+      }
+      const Vec3f offset = randomVec(rng, -3.0, 3.0);
+      const Quatf rot = randomRotation(rng);
+      if (unit(rng()) < desc.lightFraction)
+        bodyAttachments.push_back(
+            store.addLight(body, parent, offset, rot, static_cast<float>(uniform(rng, 2.0, 40.0))));
+      else
+        bodyAttachments.push_back(store.addPrimitive(
+            body, parent, offset, rot, Aabb::fromCenterHalf(randomVec(rng, -0.1, 0.1), randomVec(rng, 0.05, 1.0))));
+    }
+  }
+  BodyMotion motion(bodies, desc.seed, desc.worldExtent, desc.worldOffset);
+  return {std::move(store), std::move(motion)};
+}
+
+}  // namespace bw
