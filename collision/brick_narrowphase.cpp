@@ -104,6 +104,7 @@ int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConve
 
 }  // namespace
 
+
 namespace {
 
 // Runs f(btConvexShape&) with the query shape as a Bullet shape (no allocation).
@@ -230,32 +231,9 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
   btConvexPointCloudShape brick(verts, nv, btVector3(1, 1, 1), false);
   brick.setMargin(0);
   brick.recalcLocalAabb();
-  switch (shape.kind) {
-    case QueryShape::Kind::Sphere: {
-      btSphereShape s(shape.radius);
-      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
-    }
-    case QueryShape::Kind::Box: {
-      btBoxShape s(bt(shape.halfExtents));
-      s.setMargin(0);
-      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
-    }
-    case QueryShape::Kind::Capsule: {
-      btCapsuleShapeZ s(shape.radius, 2 * shape.halfHeight);
-      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
-    }
-    case QueryShape::Kind::Hull: {
-      // note: one buffer per thread, grown on first use only, so hull contacts do not allocate.
-      thread_local std::vector<btVector3> pts;
-      pts.resize(shape.pointCount);
-      for (uint32_t i = 0; i < shape.pointCount; ++i) pts[i] = bt(shape.points[i]);
-      btConvexPointCloudShape s(pts.data(), int(shape.pointCount), btVector3(1, 1, 1), false);
-      s.setMargin(0);
-      s.recalcLocalAabb();
-      return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
-    }
-  }
-  return 0;
+  return withBulletShape(shape, [&](btConvexShape& s) {
+    return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
+  });
 }
 
 int reduceManifold(LocalContact* c, int n, int maxOut) {

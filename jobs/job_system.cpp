@@ -57,6 +57,7 @@ struct JobSystem::Impl {
     std::lock_guard<std::mutex> lock(m);
     if (++finished == workers.size() + 1) done.notify_all();
   }
+  void run(const std::function<void()>& f) { f(); }
   void parallel(uint32_t chunks, const std::function<void(uint32_t)>& body) {
     {
       std::lock_guard<std::mutex> lock(m);
@@ -83,24 +84,6 @@ struct JobSystem::Impl {
   size_t finished = 0;
 };
 
-JobSystem::JobSystem(int threads) : threads_(threads) {
-  if (threads < 1 || threads > 1024)
-    throw InvalidInput("JobSystem: thread count is " + std::to_string(threads) + ", expected 1..1024");
-  impl_ = std::make_unique<Impl>(threads);
-}
-
-JobSystem::~JobSystem() = default;
-
-void JobSystem::parallelFor(uint32_t begin, uint32_t end, uint32_t grain,
-                            const std::function<void(uint32_t, uint32_t)>& body) {
-  if (end <= begin) return;
-  if (grain == 0) grain = 1;
-  const uint32_t chunks = chunkCount(begin, end, grain);
-  impl_->parallel(chunks, [&](uint32_t c) { body(begin + c * grain, std::min(end, begin + (c + 1) * grain)); });
-}
-
-void JobSystem::run(const std::function<void()>& f) { f(); }
-
 #else
 
 struct JobSystem::Impl {
@@ -110,7 +93,21 @@ struct JobSystem::Impl {
       : control(tbb::global_control::max_allowed_parallelism, size_t(threads)), arena(threads) {}
   tbb::global_control control;
   tbb::task_arena arena;
+  void run(const std::function<void()>& f) { arena.execute(f); }
+  void parallel(uint32_t chunks, const std::function<void(uint32_t)>& body) {
+    // note: iterate over chunk numbers, not items, so chunk boundaries are fixed whatever the
+    // partitioner does; the partitioner only decides which thread runs which chunks.
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, chunks, 1),
+                        [&](const tbb::blocked_range<uint32_t>& r) {
+                          for (uint32_t c = r.begin(); c != r.end(); ++c) body(c);
+                        },
+                        tbb::simple_partitioner());
+    });
+  }
 };
+
+#endif
 
 JobSystem::JobSystem(int threads) : threads_(threads) {
   if (threads < 1 || threads > 1024)
@@ -125,24 +122,14 @@ void JobSystem::parallelFor(uint32_t begin, uint32_t end, uint32_t grain,
   if (end <= begin) return;
   if (grain == 0) grain = 1;
   const uint32_t chunks = chunkCount(begin, end, grain);
+  auto chunk = [&](uint32_t c) { body(begin + c * grain, std::min(end, begin + (c + 1) * grain)); };
   if (threads_ == 1 || chunks == 1) {
-    for (uint32_t c = 0; c < chunks; ++c) body(begin + c * grain, std::min(end, begin + (c + 1) * grain));
+    for (uint32_t c = 0; c < chunks; ++c) chunk(c);
     return;
   }
-  // note: iterate over chunk numbers, not items, so chunk boundaries are fixed whatever the
-  // partitioner does; the partitioner only decides which thread runs which chunks.
-  impl_->arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, chunks, 1),
-                      [&](const tbb::blocked_range<uint32_t>& r) {
-                        for (uint32_t c = r.begin(); c != r.end(); ++c)
-                          body(begin + c * grain, std::min(end, begin + (c + 1) * grain));
-                      },
-                      tbb::simple_partitioner());
-  });
+  impl_->parallel(chunks, chunk);
 }
 
-void JobSystem::run(const std::function<void()>& f) { impl_->arena.execute(f); }
-
-#endif
+void JobSystem::run(const std::function<void()>& f) { impl_->run(f); }
 
 }  // namespace bw
