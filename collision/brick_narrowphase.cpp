@@ -57,6 +57,21 @@ btTransform brickTransform(const Brick& b) {
   return btTransform(m, bt(b.position));
 }
 
+// A brick's exact shape as a zero-margin Bullet point cloud over its own vertex array (no
+// allocation: the cloud does not copy the points).
+struct BrickPointCloud {
+  btVector3 verts[kMaxBrickVertices];
+  btConvexPointCloudShape shape;
+  explicit BrickPointCloud(const Brick& b) {
+    Vec3f v[kMaxBrickVertices];
+    const int n = canonicalBrickVertices(b, v);
+    for (int i = 0; i < n; ++i) verts[i] = bt(v[i]);
+    shape.setPoints(verts, n, false);
+    shape.setMargin(0);
+    shape.recalcLocalAabb();
+  }
+};
+
 btTransform poseTransform(const LocalPose& p) {
   return btTransform(btQuaternion(p.rotation.x(), p.rotation.y(), p.rotation.z(), p.rotation.w()), bt(p.position));
 }
@@ -160,13 +175,8 @@ bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f
       return true;
     }
   }
-  btVector3 verts[kMaxBrickVertices];
-  Vec3f v[kMaxBrickVertices];
-  const int nv = canonicalBrickVertices(b, v);
-  for (int i = 0; i < nv; ++i) verts[i] = bt(v[i]);
-  btConvexPointCloudShape brick(verts, nv, btVector3(1, 1, 1), false);
-  brick.setMargin(0);
-  brick.recalcLocalAabb();
+  BrickPointCloud cloud(b);
+  const btConvexPointCloudShape& brick = cloud.shape;
   const btTransform trBrick = brickTransform(b);
   const btQuaternion q(rotation.x(), rotation.y(), rotation.z(), rotation.w());
   const Vec3f motion = to - from;
@@ -223,16 +233,9 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
     // a speculative point when a margin is asked for.
     if (col.count > 0 || speculativeMargin <= 0.f) return col.count;
   }
-  // Brick as a zero-margin point cloud over stack vertices (no allocation).
-  btVector3 verts[kMaxBrickVertices];
-  Vec3f v[kMaxBrickVertices];
-  const int nv = canonicalBrickVertices(b, v);
-  for (int i = 0; i < nv; ++i) verts[i] = bt(v[i]);
-  btConvexPointCloudShape brick(verts, nv, btVector3(1, 1, 1), false);
-  brick.setMargin(0);
-  brick.recalcLocalAabb();
+  BrickPointCloud cloud(b);
   return withBulletShape(shape, [&](btConvexShape& s) {
-    return gjkEpa(s, trShape, brick, trBrick, feature, b.material, speculativeMargin, out);
+    return gjkEpa(s, trShape, cloud.shape, trBrick, feature, b.material, speculativeMargin, out);
   });
 }
 
