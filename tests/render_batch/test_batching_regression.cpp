@@ -104,8 +104,6 @@ void PrintTo(const Case& c, std::ostream* os) { *os << caseLabel(c); }
 class BatchingDifferential : public ::testing::TestWithParam<Case> {};
 
 TEST_P(BatchingDifferential, MatchesSerialReferenceFrameByFrame) {
-  if (test::kThreadSanitizer && GetParam().runner == Runner::JobSystem2)
-    GTEST_SKIP() << "oneTBB scheduler is not TSan-instrumented; the ThreadTeam4 variant covers this mode";
   const ReferenceRun& ref = reference();
   const SubmissionMode mode = GetParam().mode;
   AttachmentWorkload w = makeWorkload();

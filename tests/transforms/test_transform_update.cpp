@@ -123,8 +123,6 @@ void PrintTo(Runner r, std::ostream* os) { *os << runnerName(::testing::TestPara
 class TransformUpdateDifferential : public ::testing::TestWithParam<Runner> {};
 
 TEST_P(TransformUpdateDifferential, MatchesSerialReferenceEveryFrame) {
-  if (test::kThreadSanitizer && (GetParam() == Runner::JobSystem2 || GetParam() == Runner::JobSystem4))
-    GTEST_SKIP() << "oneTBB scheduler is not TSan-instrumented; the ThreadTeam3 variant covers this code";
   AttachmentWorkload w = makeAttachmentWorkload({.attachments = 4000, .seed = 21, .maxDepth = 4});
   Reference ref(w.store);
   RecordCollector records(w.store.primitiveCount(), w.store.lightCount());
@@ -150,9 +148,7 @@ INSTANTIATE_TEST_SUITE_P(Runners, TransformUpdateDifferential,
                          runnerName);
 
 TEST(TransformUpdate, ObjectStyleBaselineProducesIdenticalRecords) {
-  // note: under TSan the job system runs on one thread (oneTBB is not instrumented); this
-  // test is about equal results, the parallel paths are covered by the differential test.
-  const int threads = test::kThreadSanitizer ? 1 : 2;
+  const int threads = 2;
   AttachmentWorkload w = makeAttachmentWorkload({.attachments = 3000, .seed = 33, .maxDepth = 3});
   ObjectStyleScene objects(w.store);
   RecordCollector soa(w.store.primitiveCount(), w.store.lightCount());

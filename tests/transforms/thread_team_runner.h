@@ -10,21 +10,6 @@
 
 namespace bw::test {
 
-/// True in ThreadSanitizer builds. Debian's oneTBB is not instrumented, so concurrency that
-/// runs inside its scheduler (JobSystem with > 1 thread) produces false reports there; those
-/// test variants skip under TSan and their std::thread twins cover the same code.
-#if defined(__SANITIZE_THREAD__)
-inline constexpr bool kThreadSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-inline constexpr bool kThreadSanitizer = true;
-#else
-inline constexpr bool kThreadSanitizer = false;
-#endif
-#else
-inline constexpr bool kThreadSanitizer = false;
-#endif
-
 /// Splits each level into `threads` contiguous ranges run on their own std::thread.
 inline void runOnThreadTeam(TransformUpdate& update, uint32_t threads) {
   std::vector<std::thread> team;
