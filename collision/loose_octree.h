@@ -93,6 +93,8 @@ class LooseOctree {
   void forEachHeld(const Cluster& cl, int s, F&& f) const {
     for (uint32_t e = cl.head[s]; e != octobvh::kNone; e = elements_.get<1>(e)) f(e);
   }
+  template <class Hit, class OnElement>
+  void walkOverlap(uint32_t mask, QueryStats* stats, Hit&& hit, OnElement&& onElement) const;
   template <class Hit>
   void traverseRay(const Ray& ray, uint32_t mask, const std::array<uint8_t, 8>& order, float& limit, bool& stop,
                    QueryStats* stats, Hit&& onElement) const;

@@ -13,47 +13,10 @@ struct RayEntry {
 };
 }  // namespace loose_detail
 
-template <class F, class Exact>
-void LooseOctree::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
+// The one overlap walk: `hit` tests a box (loose node cube or element bounds) against the query.
+template <class Hit, class OnElement>
+void LooseOctree::walkOverlap(uint32_t mask, QueryStats* stats, Hit&& hit, OnElement&& onElement) const {
   using namespace octobvh;
-  uint64_t tests = 0, elementTests = 0;
-  uint32_t stack[loose_detail::kStackSize];
-  int sp = 0;
-  if (clusters_[rootCluster_].subtree[0]) {
-    ++tests;
-    if (looseBounds(clusters_[rootCluster_], 0).overlaps(box)) stack[sp++] = nodeRef(rootCluster_, 0);
-  }
-  while (sp) {
-    const uint32_t ref = stack[--sp];
-    const Cluster& cl = clusters_[ref >> 3];
-    const int s = int(ref & 7);
-    forEachHeld(cl, s, [&](uint32_t e) {
-      const ElementRecord& r = elements_.template get<0>(e);
-      if (!(r.filter & mask)) return;
-      ++tests;
-      ++elementTests;
-      const Aabb b = r.bounds();
-      if (b.overlaps(box) && exact(e, b)) f(e);
-    });
-    if (cl.child[s] == kNone) continue;
-    const Cluster& ch = clusters_[cl.child[s]];
-    for (int o = 0; o < 8; ++o) {
-      if (!ch.subtree[o]) continue;
-      ++tests;
-      if (looseBounds(ch, o).overlaps(box)) stack[sp++] = nodeRef(cl.child[s], o);
-    }
-  }
-  if (stats) {
-    stats->boxTests += tests;
-    stats->elementTests += elementTests;
-  }
-}
-
-template <class F, class Exact>
-void LooseOctree::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
-  using namespace octobvh;
-  const Aabb outer = box.bounds();
-  auto hit = [&](const Aabb& b) { return b.overlaps(outer) && bw::overlaps(box, b); };
   uint64_t tests = 0, elementTests = 0;
   uint32_t stack[loose_detail::kStackSize];
   int sp = 0;
@@ -71,7 +34,7 @@ void LooseOctree::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stat
       ++tests;
       ++elementTests;
       const Aabb b = r.bounds();
-      if (hit(b) && exact(e, b)) f(e);
+      if (hit(b)) onElement(e, b);
     });
     if (cl.child[s] == kNone) continue;
     const Cluster& ch = clusters_[cl.child[s]];
@@ -85,6 +48,23 @@ void LooseOctree::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stat
     stats->boxTests += tests;
     stats->elementTests += elementTests;
   }
+}
+
+template <class F, class Exact>
+void LooseOctree::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
+  walkOverlap(mask, stats, [&](const Aabb& b) { return b.overlaps(box); },
+              [&](uint32_t e, const Aabb& b) {
+                if (exact(e, b)) f(e);
+              });
+}
+
+template <class F, class Exact>
+void LooseOctree::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
+  const Aabb outer = box.bounds();
+  walkOverlap(mask, stats, [&](const Aabb& b) { return b.overlaps(outer) && bw::overlaps(box, b); },
+              [&](uint32_t e, const Aabb& b) {
+                if (exact(e, b)) f(e);
+              });
 }
 
 template <class Hit>

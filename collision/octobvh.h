@@ -178,6 +178,8 @@ class OctoBvh {
   void heldTake(uint32_t c, int s, std::vector<uint32_t>& out);
   template <class F>
   void forEachHeld(const NodeCluster& cl, int s, F&& f) const;
+  template <class OnElement, class Accept>
+  void walkOverlap(const Aabb& outer, uint32_t mask, QueryStats* stats, OnElement&& onElement, Accept&& accept) const;
 
   uint64_t hashNode(uint32_t c, int s) const;
   void validateNode(uint32_t c, int s, const Cube& cube, std::vector<uint32_t>& seen) const;

@@ -52,8 +52,12 @@ inline bool elementOverlaps(const octobvh::ElementRecord& r, const Aabb& b) {
 }
 }  // namespace octobvh_detail
 
-template <class F, class Exact>
-void OctoBvh::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
+// The one depth-first overlap walk behind every overlap form: nodes are culled by the SoA test
+// against `outer`; accept(cluster, slot) may reject a node further (the OBB's SAT) or take it
+// whole (a LOD box) by returning false; onElement(e, record) tests and reports one element.
+template <class OnElement, class Accept>
+void OctoBvh::walkOverlap(const Aabb& outer, uint32_t mask, QueryStats* stats, OnElement&& onElement,
+                          Accept&& accept) const {
   using namespace octobvh;
   using namespace octobvh_detail;
   const NodeCluster& root = clusters_[rootCluster_];
@@ -62,7 +66,7 @@ void OctoBvh::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, 
     ++tests;
     uint32_t stack[kStackSize];
     int sp = 0;
-    if (root.bounds(0).overlaps(box)) stack[sp++] = nodeRef(rootCluster_, 0);
+    if (root.bounds(0).overlaps(outer) && accept(rootCluster_, 0)) stack[sp++] = nodeRef(rootCluster_, 0);
     while (sp) {
       const uint32_t ref = stack[--sp];
       const NodeCluster& cl = clusters_[ref >> 3];
@@ -72,16 +76,17 @@ void OctoBvh::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, 
         if (!(r.filter & mask)) return;
         ++tests;
         ++elementTests;
-        if (elementOverlaps(r, box) && exact(e, r.bounds())) f(e);
+        onElement(e, r);
       });
       if (cl.child[s] == kNone) continue;
+      const uint32_t c = cl.child[s];
       unsigned candidates;
-      unsigned hits = overlapMask(clusters_[cl.child[s]], box, mask, candidates);
+      unsigned hits = overlapMask(clusters_[c], outer, mask, candidates);
       tests += unsigned(std::popcount(candidates));
       while (hits) {
         const int o = std::countr_zero(hits);
         hits &= hits - 1;
-        stack[sp++] = nodeRef(cl.child[s], o);
+        if (accept(c, o)) stack[sp++] = nodeRef(c, o);
       }
     }
   }
@@ -92,102 +97,48 @@ void OctoBvh::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, 
 }
 
 template <class F, class Exact>
+void OctoBvh::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
+  walkOverlap(
+      box, mask, stats,
+      [&](uint32_t e, const octobvh::ElementRecord& r) {
+        if (octobvh_detail::elementOverlaps(r, box) && exact(e, r.bounds())) f(e);
+      },
+      [](uint32_t, int) { return true; });
+}
+
+template <class F, class Exact>
 void OctoBvh::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
-  using namespace octobvh;
-  using namespace octobvh_detail;
+  // note: the cheap AABB-of-the-OBB test (the walk's cull) rejects most nodes before the 15-axis SAT.
   const Aabb outer = box.bounds();
-  const NodeCluster& root = clusters_[rootCluster_];
-  uint64_t tests = 0, elementTests = 0;
-  // note: the cheap AABB-of-the-OBB test rejects most nodes before the 15-axis SAT runs.
-  auto hit = [&](const Aabb& b) { return b.overlaps(outer) && bw::overlaps(box, b); };
-  if (root.filter[0] & mask) {
-    ++tests;
-    uint32_t stack[kStackSize];
-    int sp = 0;
-    if (hit(root.bounds(0))) stack[sp++] = nodeRef(rootCluster_, 0);
-    while (sp) {
-      const uint32_t ref = stack[--sp];
-      const NodeCluster& cl = clusters_[ref >> 3];
-      const int s = int(ref & 7);
-      forEachHeld(cl, s, [&](uint32_t e) {
-        const ElementRecord& r = elements_[e];
-        if (!(r.filter & mask)) return;
-        ++tests;
-        ++elementTests;
+  walkOverlap(
+      outer, mask, stats,
+      [&](uint32_t e, const octobvh::ElementRecord& r) {
         const Aabb eb = r.bounds();
-        if (hit(eb) && exact(e, eb)) f(e);
-      });
-      if (cl.child[s] == kNone) continue;
-      unsigned candidates;
-      unsigned near = overlapMask(clusters_[cl.child[s]], outer, mask, candidates);
-      tests += unsigned(std::popcount(candidates));
-      const NodeCluster& ch = clusters_[cl.child[s]];
-      while (near) {
-        const int o = std::countr_zero(near);
-        near &= near - 1;
-        if (bw::overlaps(box, ch.bounds(o))) stack[sp++] = nodeRef(cl.child[s], o);
-      }
-    }
-  }
-  if (stats) {
-    stats->boxTests += tests;
-    stats->elementTests += elementTests;
-  }
+        if (eb.overlaps(outer) && bw::overlaps(box, eb) && exact(e, eb)) f(e);
+      },
+      [&](uint32_t c, int o) { return bw::overlaps(box, clusters_[c].bounds(o)); });
 }
 
 template <class F, class L>
 void OctoBvh::overlapLod(const Aabb& box, uint32_t mask, float lodFraction, F&& onElement, L&& onLod,
                          QueryStats* stats) const {
   using namespace octobvh;
-  using namespace octobvh_detail;
   const float threshold = lodFraction * box.extent().maxCoeff();
-  const NodeCluster& root = clusters_[rootCluster_];
-  uint64_t tests = 0, elementTests = 0;
-  auto subtreeCount = [&](uint32_t c, int s) {
-    const NodeCluster& cl = clusters_[c];
-    return heldCount(c, s) + (cl.child[s] != kNone ? clusters_[cl.child[s]].childTotal : 0u);
-  };
-  // A subtree is "small" when its tight bounds' largest extent is below the threshold.
-  auto small = [&](const NodeCluster& cl, int o) {
-    return cl.maxX[o] - cl.minX[o] < threshold && cl.maxY[o] - cl.minY[o] < threshold && cl.maxZ[o] - cl.minZ[o] < threshold;
-  };
-  if (root.filter[0] & mask) {
-    ++tests;
-    uint32_t stack[kStackSize];
-    int sp = 0;
-    if (root.bounds(0).overlaps(box)) {
-      if (small(root, 0)) onLod(LodBox{root.bounds(0), root.filter[0], subtreeCount(rootCluster_, 0)});
-      else stack[sp++] = nodeRef(rootCluster_, 0);
-    }
-    while (sp) {
-      const uint32_t ref = stack[--sp];
-      const NodeCluster& cl = clusters_[ref >> 3];
-      const int s = int(ref & 7);
-      forEachHeld(cl, s, [&](uint32_t e) {
-        const ElementRecord& r = elements_[e];
-        if (!(r.filter & mask)) return;
-        ++tests;
-        ++elementTests;
-        if (elementOverlaps(r, box)) onElement(e);
+  walkOverlap(
+      box, mask, stats,
+      [&](uint32_t e, const ElementRecord& r) {
+        if (octobvh_detail::elementOverlaps(r, box)) onElement(e);
+      },
+      [&](uint32_t c, int o) {
+        // A subtree is "small" when its tight bounds' largest extent is below the threshold.
+        const NodeCluster& cl = clusters_[c];
+        if (!(cl.maxX[o] - cl.minX[o] < threshold && cl.maxY[o] - cl.minY[o] < threshold &&
+              cl.maxZ[o] - cl.minZ[o] < threshold))
+          return true;
+        const uint32_t n = heldCount(c, o) + (cl.child[o] != kNone ? clusters_[cl.child[o]].childTotal : 0u);
+        onLod(LodBox{cl.bounds(o), cl.filter[o], n});
+        return false;
       });
-      if (cl.child[s] == kNone) continue;
-      const uint32_t c = cl.child[s];
-      const NodeCluster& ch = clusters_[c];
-      unsigned candidates;
-      unsigned hits = overlapMask(ch, box, mask, candidates);
-      tests += unsigned(std::popcount(candidates));
-      while (hits) {
-        const int o = std::countr_zero(hits);
-        hits &= hits - 1;
-        if (small(ch, o)) onLod(LodBox{ch.bounds(o), ch.filter[o], subtreeCount(c, o)});
-        else stack[sp++] = nodeRef(c, o);
-      }
-    }
-  }
-  if (stats) {
-    stats->boxTests += tests;
-    stats->elementTests += elementTests;
-  }
 }
 
 inline std::array<uint8_t, 8> OctoBvh::rayChildOrder(const Vec3f& dir) {
