@@ -21,13 +21,16 @@ struct KinematicMotion {
   Vec3f angularVelocity = Vec3f::Zero();  ///< rad/s about the body's centre
 };
 
-/// One grid: bricks from a generator or listed explicitly, and its placement.
+/// One grid: bricks from a generator, a Brickadia save or listed explicitly, and its placement.
 struct GridDescription {
   std::string name;
-  std::string generator;           ///< one of buildNames(), or empty for `bricks`
+  std::string generator;           ///< one of buildNames(), or empty
   float scale = 1.f;
   uint64_t seed = 1;
-  std::vector<Brick> bricks;       ///< explicit bricks (when no generator)
+  std::string file;                ///< a .brs save (path resolved against the scene file), or empty
+  int tilesX = 1, tilesY = 1;      ///< the save (or generated build) copied on a tilesX x tilesY grid
+  float tileGap = 0.f;             ///< gap between tiles
+  std::vector<Brick> bricks;       ///< explicit bricks (when neither generator nor file)
   Vec3d position = Vec3d::Zero();
   Quatf rotation = Quatf::Identity();
   MotionType motion = MotionType::Static;
@@ -49,6 +52,23 @@ struct SpawnerDescription {
   uint64_t seed = 1;
 };
 
+/// A voxel terrain from a MagicaVoxel model (static; solid voxels collide, water voxels float).
+struct TerrainDescription {
+  std::string name;
+  std::string file;                ///< .vox path (resolved against the scene file)
+  float voxelSize = 1.f;           ///< edge of one voxel in world units
+  Vec3d position = Vec3d::Zero();  ///< world position of the terrain's voxel (0, 0, 0) corner
+  int waterFirst = -1, waterLast = -1;  ///< palette index range that is water (-1: none)
+  float waterDensity = 1000.f;     ///< kg/m^3, for buoyancy
+};
+
+/// Rays fired across the scene's grids every frame (a query load beside the simulation).
+struct RayLoadDescription {
+  uint32_t count = 0;              ///< rays per frame
+  float length = 0.f;              ///< 0: long enough to cross the grids' bounds
+  uint64_t seed = 1;
+};
+
 /// Global settings of a run.
 struct SceneSettings {
   Vec3d gravity{0, 0, -9.81};
@@ -59,6 +79,9 @@ struct SceneSettings {
   float lodFraction = 1.f / 16;
   int approximationDepth = 3;
   bool sleeping = true;
+  int manifoldSize = 4;              ///< contacts kept per pair after reduction (1..64)
+  double reuseTranslation = 1e-3;    ///< pair cache: reuse contacts while the relative pose moved
+  float reuseRotation = 1e-3f;       ///< less than this (m, rad) since they were made; 0 disables
 };
 
 struct SceneDescription {
@@ -67,6 +90,8 @@ struct SceneDescription {
   SceneSettings settings;
   std::vector<GridDescription> grids;
   std::vector<SpawnerDescription> spawners;
+  std::vector<TerrainDescription> terrains;
+  RayLoadDescription rays;
 };
 
 }  // namespace bw

@@ -1,6 +1,7 @@
 #include "world/scene_file.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
@@ -141,13 +142,37 @@ MotionType parseMotion(const Field& f) {
   return m == "static" ? MotionType::Static : m == "kinematic" ? MotionType::Kinematic : MotionType::Dynamic;
 }
 
-GridDescription parseGrid(const Field& f) {
-  f.allowOnly({"name", "generator", "scale", "seed", "bricks", "position", "rotation", "motion", "linear_velocity", "angular_velocity"});
+// A content file named in a scene: relative paths are relative to the scene file's folder. The
+// file must exist now, so a typo fails before anything is built.
+std::string contentPath(const Field& f, const std::string& sceneSource, const char* extension) {
+  const std::string name = f.string();
+  std::filesystem::path p(name);
+  if (p.extension() != extension) f.fail(std::string("a path to a ") + extension + " file");
+  if (p.is_relative()) p = std::filesystem::path(sceneSource).parent_path() / p;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(p, ec)) f.failMessage("no such file: " + p.string());
+  return p.string();
+}
+
+GridDescription parseGrid(const Field& f, const std::string& sceneSource) {
+  f.allowOnly({"name", "generator", "scale", "seed", "file", "tiles", "tile_gap", "bricks", "position", "rotation", "motion",
+               "linear_velocity", "angular_velocity"});
   GridDescription g;
   g.name = f.at("name").string();
   if (g.name.empty()) f.at("name").fail("a non-empty name");
-  if (f.has("generator") == f.has("bricks")) f.failMessage("needs exactly one of 'generator' or 'bricks'");
-  if (f.has("generator")) {
+  if (int(f.has("generator")) + int(f.has("bricks")) + int(f.has("file")) != 1)
+    f.failMessage("needs exactly one of 'generator', 'file' or 'bricks'");
+  if (f.has("tiles")) {
+    const Field t = f.at("tiles");
+    if (t.arraySize(2) != 2) t.fail("[tiles along x, tiles along y]");
+    g.tilesX = int(t.index(0).integer(1, 1000));
+    g.tilesY = int(t.index(1).integer(1, 1000));
+    if (f.has("bricks")) t.failMessage("tiles apply to a generator or a file, not to explicit bricks");
+  }
+  if (f.has("tile_gap")) g.tileGap = float(f.at("tile_gap").number(0, 1e5));
+  if (f.has("file")) {
+    g.file = contentPath(f.at("file"), sceneSource, ".brs");
+  } else if (f.has("generator")) {
     const Field gen = f.at("generator");
     g.generator = gen.string();
     const auto names = buildNames();
@@ -207,7 +232,8 @@ SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescriptio
 }
 
 SceneSettings parseSettings(const Field& f) {
-  f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping"});
+  f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping",
+               "manifold_size", "reuse_translation", "reuse_rotation"});
   SceneSettings s;
   if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-1000, 1000);
   if (f.has("timestep")) s.timestep = f.at("timestep").number(1.0 / 10000, 1.0 / 10);
@@ -217,7 +243,37 @@ SceneSettings parseSettings(const Field& f) {
   if (f.has("lod_fraction")) s.lodFraction = float(f.at("lod_fraction").number(0, 1));
   if (f.has("approximation_depth")) s.approximationDepth = int(f.at("approximation_depth").integer(0, 7));
   if (f.has("sleeping")) s.sleeping = f.at("sleeping").boolean();
+  if (f.has("manifold_size")) s.manifoldSize = int(f.at("manifold_size").integer(1, 64));
+  if (f.has("reuse_translation")) s.reuseTranslation = f.at("reuse_translation").number(0, 1);
+  if (f.has("reuse_rotation")) s.reuseRotation = float(f.at("reuse_rotation").number(0, 1));
   return s;
+}
+
+TerrainDescription parseTerrain(const Field& f, const std::string& sceneSource) {
+  f.allowOnly({"name", "file", "voxel_size", "position", "water", "water_density"});
+  TerrainDescription t;
+  t.name = f.at("name").string();
+  t.file = contentPath(f.at("file"), sceneSource, ".vox");
+  if (f.has("voxel_size")) t.voxelSize = float(f.at("voxel_size").number(1e-3, 1e3));
+  if (f.has("position")) t.position = f.at("position").vec3(-kMaxCoord, kMaxCoord);
+  if (f.has("water")) {
+    const Field w = f.at("water");
+    if (w.arraySize(2) != 2) w.fail("[first, last] palette indices");
+    t.waterFirst = int(w.index(0).integer(1, 255));
+    t.waterLast = int(w.index(1).integer(1, 255));
+    if (t.waterFirst > t.waterLast) w.failMessage("first palette index is greater than the last");
+  }
+  if (f.has("water_density")) t.waterDensity = float(f.at("water_density").number(1, 1e5));
+  return t;
+}
+
+RayLoadDescription parseRays(const Field& f) {
+  f.allowOnly({"count", "length", "seed"});
+  RayLoadDescription r;
+  r.count = uint32_t(f.at("count").integer(0, 10'000'000));
+  if (f.has("length")) r.length = float(f.at("length").number(0, 1e7));
+  if (f.has("seed")) r.seed = f.at("seed").seed();
+  return r;
 }
 
 }  // namespace
@@ -230,7 +286,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     throw SceneError(sourceName + ": not valid JSON (" + e.what() + ")");
   }
   const Field root(doc, "scene", sourceName);
-  root.allowOnly({"name", "description", "settings", "grids", "spawners"});
+  root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays"});
   SceneDescription scene;
   scene.source = sourceName;
   scene.name = root.at("name").string();
@@ -241,7 +297,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     const size_t n = grids.arraySize(100'000);
     std::set<std::string> names;
     for (size_t i = 0; i < n; ++i) {
-      scene.grids.push_back(parseGrid(grids.index(i)));
+      scene.grids.push_back(parseGrid(grids.index(i), sourceName));
       if (!names.insert(scene.grids.back().name).second)
         grids.index(i).at("name").fail("a name not used by another grid");
     }
@@ -251,7 +307,14 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     const size_t n = spawners.arraySize(10'000);
     for (size_t i = 0; i < n; ++i) scene.spawners.push_back(parseSpawner(spawners.index(i), scene.grids));
   }
-  if (scene.grids.empty() && scene.spawners.empty()) root.failMessage("declares no grids and no spawners: nothing to simulate");
+  if (root.has("terrains")) {
+    const Field terrains = root.at("terrains");
+    const size_t n = terrains.arraySize(64);
+    for (size_t i = 0; i < n; ++i) scene.terrains.push_back(parseTerrain(terrains.index(i), sourceName));
+  }
+  if (root.has("rays")) scene.rays = parseRays(root.at("rays"));
+  if (scene.grids.empty() && scene.spawners.empty() && scene.terrains.empty())
+    root.failMessage("declares no grids, spawners or terrains: nothing to simulate");
   return scene;
 }
 

@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <limits>
 
+#include "collision/brs_reader.h"
 #include "collision/build_generators.h"
+#include "collision/build_tiling.h"
 #include "collision/input_validation.h"
 #include "collision/seeded_random.h"
 #include "world/scene_file.h"
@@ -27,8 +30,6 @@ constexpr float kBounceThreshold = 1.0f;
 constexpr float kSleepLinear = 0.05f, kSleepAngular = 0.1f, kSleepTime = 0.5f;
 // Pair cache: contacts are reused while the relative pose moved less than these since they were
 // made (a resting pile moves micrometres per step).
-constexpr double kReuseTranslation = 1e-3;
-constexpr float kReuseRotation = 1e-3f;  // radians
 
 void primitiveMass(const QueryShape& s, float density, float& invMass, Vec3f& invInertia) {
   float m;
@@ -92,8 +93,33 @@ uint64_t World::brickCount() const {
   return n;
 }
 
+// Bricks of a grid description: a generator's build, a save's bricks, or the listed ones, then
+// tiled when asked. Content errors name the scene, the grid and the file.
+std::vector<Brick> World::gridBricks(const GridDescription& g) const {
+  std::vector<Brick> bricks;
+  Aabb bounds = Aabb::empty();
+  try {
+    if (!g.file.empty()) {
+      BrsLoadResult save = loadBrs(g.file);
+      bricks = std::move(save.bricks);
+      bounds = save.bounds;
+    } else if (!g.generator.empty()) {
+      GeneratedBuild build = generateBuild(g.generator, g.seed, g.scale);
+      bricks = std::move(build.bricks);
+      bounds = build.bounds;
+    } else {
+      return g.bricks;
+    }
+    if (g.tilesX > 1 || g.tilesY > 1) bricks = tileBuild(bricks, bounds, g.tilesX, g.tilesY, g.tileGap);
+  } catch (const InvalidInput& e) {
+    throw SceneError(scene_.source + ": grid '" + g.name + "': " + e.what());
+  }
+  if (bricks.empty()) throw SceneError(scene_.source + ": grid '" + g.name + "': has no bricks with collision");
+  return bricks;
+}
+
 void World::buildGrid(const GridDescription& g) {
-  std::vector<Brick> bricks = g.generator.empty() ? g.bricks : generateBuild(g.generator, g.seed, g.scale).bricks;
+  const std::vector<Brick> bricks = gridBricks(g);
   auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(bricks.size() + 1024)));
   for (const Brick& b : bricks) grid->placeBrick(b);
   grids_.push_back(std::move(grid));
@@ -190,6 +216,7 @@ void World::generateContacts(float dt) {
   pairStats_.assign(n, ContactStats{});
   ContactParams base;
   base.lodFraction = scene_.settings.lodFraction;
+  base.maxContacts = scene_.settings.manifoldSize;
   // Convex approximations are cached per grid and refreshed lazily: warm them serially so the
   // parallel stage only reads them (copies of one crate grid share one cache).
   for (const BodyPair& p : pairs_) {
@@ -220,8 +247,8 @@ void World::generateContacts(float dt) {
       if (pairCacheHit_[k] >= 0) {
         const PairCacheEntry& e = pairCache_[size_t(pairCacheHit_[k])];
         const RigidTransform rel = poseA.inverse() * poseB;
-        const bool still = (rel.translation - e.relative.translation).norm() < kReuseTranslation &&
-                           e.relative.rotation.angularDistance(rel.rotation) < kReuseRotation;
+        const bool still = (rel.translation - e.relative.translation).norm() < scene_.settings.reuseTranslation &&
+                           e.relative.rotation.angularDistance(rel.rotation) < scene_.settings.reuseRotation;
         if (still) {
           // Re-pose the cached points and measure the depth along the normal again.
           for (uint32_t i = 0; i < e.count; ++i) {
@@ -550,12 +577,63 @@ void World::substep(float dt, int index) {
   }
 }
 
+// The scene's ray load: seeded rays between random points of the grids' bounds, each cast
+// against every grid body (in the grid's frame) and keeping the closest hit. One slot per ray,
+// so the result does not depend on the thread count. Rays read the world; they change nothing.
+void World::fireRays() {
+  const RayLoadDescription& load = scene_.rays;
+  if (load.count == 0) return;
+  const auto t = Clock::now();
+  Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<uint32_t> gridBodies;
+  for (uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (!bodies_.shape[i].isGrid() || bodies_.motion[i] == MotionType::Dynamic) continue;
+    gridBodies.push_back(i);
+    lo = lo.cwiseMin(bounds_[i].min);
+    hi = hi.cwiseMax(bounds_[i].max);
+  }
+  if (gridBodies.empty()) return;
+  rayHitT_.assign(load.count, std::numeric_limits<float>::infinity());
+  rayStats_.assign(load.count, QueryStats{});
+  const uint64_t seed = load.seed ^ (uint64_t(frame_) * 0x9E3779B97F4A7C15ull);
+  const int stage = scene_.settings.substeps * 5;
+  jobs_.parallelFor(0, load.count, 64, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler_, "rays", stage);
+    for (uint32_t k = begin; k < end; ++k) {
+      SeededRandom r(seed + k);
+      const Vec3d from(r.uniform(lo.x(), hi.x()), r.uniform(lo.y(), hi.y()), r.uniform(lo.z(), hi.z()));
+      const Vec3d to(r.uniform(lo.x(), hi.x()), r.uniform(lo.y(), hi.y()), r.uniform(lo.z(), hi.z()));
+      const double span = (to - from).norm();
+      if (span == 0) continue;
+      const Vec3d dir = (to - from) / span;
+      const double length = load.length > 0 ? double(load.length) : (hi - lo).norm();
+      for (uint32_t body : gridBodies) {
+        const RigidTransform pose = bodies_.shapePose(body);
+        const Ray ray = Ray::make(pose.pointToLocal(from), pose.directionToLocal(Vec3f(dir.cast<float>())),
+                                  std::min(float(length), rayHitT_[k]));
+        const GridRayHit hit = grids_[bodies_.shape[body].grid]->raycast(ray, ~0u, &rayStats_[k]);
+        if (hit.hit()) rayHitT_[k] = hit.t;
+      }
+    }
+  });
+  stats_.rays = load.count;
+  for (uint32_t k = 0; k < load.count; ++k) {
+    stats_.rayHits += std::isfinite(rayHitT_[k]) ? 1u : 0u;
+    stats_.rayBoxTests += rayStats_[k].boxTests;
+  }
+  stats_.raysMs = msSince(t);
+}
+
 void World::step() {
   const auto t = Clock::now();
   stats_ = StepStats{};
   profiler_.beginFrame(frame_);
   const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
   for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt, s);
+  {
+    ProfileZone z(profiler_, "rays (stage)");
+    fireRays();
+  }
   profiler_.endFrame();
   stats_.totalMs = msSince(t);
   ++frame_;

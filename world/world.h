@@ -35,6 +35,11 @@ struct StepStats {
   uint64_t boxTests = 0;
   uint32_t narrowphase = 0;
   uint32_t pairsReused = 0;   ///< pairs whose contacts came from the pair cache
+  double raysMs = 0;          ///< the scene's ray load (once per frame, not per substep)
+  uint32_t rays = 0, rayHits = 0;
+  uint64_t rayBoxTests = 0;
+  uint32_t terrainContacts = 0;  ///< contacts against terrains (included in contacts)
+  uint32_t floating = 0;         ///< bodies touching water
 };
 
 class World {
@@ -92,7 +97,9 @@ class World {
     float n, t1, t2;
   };
 
+  std::vector<Brick> gridBricks(const GridDescription& g) const;
   void buildGrid(const GridDescription& g);
+  void fireRays();
   void spawn(const SpawnerDescription& s);
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
@@ -137,6 +144,8 @@ class World {
   std::vector<int32_t> pairCacheHit_;  // per pair slot: index into pairCache_ or -1
   void updatePairCache();
   StepStats stats_;
+  std::vector<float> rayHitT_;  // per ray of the ray load: closest hit (inf: none)
+  std::vector<QueryStats> rayStats_;
   uint32_t frame_ = 0;
   int stage_ = 0;  // first profiling stage id of the running substep
 };

@@ -99,13 +99,14 @@ int runScene(const SceneRunOptions& o) {
   const double buildMs = std::chrono::duration<double, std::milli>(Clock::now() - tBuild).count();
   const uint32_t frames = o.frames ? o.frames : scene.settings.frames;
 
-  Series total, broad, contacts, solver, integrate;
-  uint64_t pairs = 0, contactCount = 0, boxTests = 0, reused = 0;
+  Series total, broad, contacts, solver, integrate, rays;
+  uint64_t pairs = 0, contactCount = 0, boxTests = 0, reused = 0, rayCount = 0, rayHits = 0, rayBoxTests = 0, terrainContacts = 0;
+  uint32_t floating = 0;
   std::ofstream csv;
   if (!o.csvPath.empty()) {
     csv.open(o.csvPath);
     if (!csv) throw std::runtime_error("cannot write " + o.csvPath);
-    csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,pairs,contacts,box_tests\n";
+    csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,rays_ms,pairs,contacts,box_tests,ray_hits\n";
   }
   double work = 0, span = 0;
   const auto tRun = Clock::now();
@@ -117,12 +118,19 @@ int runScene(const SceneRunOptions& o) {
     contacts.v.push_back(s.contactsMs);
     solver.v.push_back(s.solverMs);
     integrate.v.push_back(s.integrateMs);
+    rays.v.push_back(s.raysMs);
+    rayCount += s.rays;
+    rayHits += s.rayHits;
+    rayBoxTests += s.rayBoxTests;
+    terrainContacts += s.terrainContacts;
+    floating = s.floating;
     pairs += s.pairs;
     contactCount += s.contacts;
     boxTests += s.boxTests;
     reused += s.pairsReused;
     if (csv) csv << f << "," << s.totalMs << "," << s.broadphaseMs << "," << s.contactsMs << "," << s.solverMs << ","
-                 << s.integrateMs << "," << s.pairs << "," << s.contacts << "," << s.boxTests << "\n";
+                 << s.integrateMs << "," << s.raysMs << "," << s.pairs << "," << s.contacts << "," << s.boxTests << "," << s.rayHits
+                 << "\n";
     if (o.progress && !o.json && frames >= 100 && (f + 1) % (frames / 10) == 0)
       std::fprintf(stderr, "  frame %u/%u  %.2f ms\n", f + 1, frames, s.totalMs);
   }
@@ -169,6 +177,16 @@ int runScene(const SceneRunOptions& o) {
                      {"dynamic_moving", moving},
                      {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
                      {"state_hash", world.stateHash()}};
+    if (!scene.terrains.empty()) {
+      j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
+      j["dynamic_floating"] = floating;
+    }
+    if (rayCount) {
+      j["rays"] = stage(rays);
+      j["rays_per_frame"] = double(rayCount) / frames;
+      j["ray_hit_share"] = double(rayHits) / double(rayCount);
+      j["ray_box_tests_per_ray"] = double(rayBoxTests) / double(rayCount);
+    }
     if (o.engine == "both") {
       nlohmann::json b;
       World fresh(scene, o.threads);
@@ -183,10 +201,17 @@ int runScene(const SceneRunOptions& o) {
               path.c_str(), world.bodies().size(), (unsigned long long)world.brickCount(), buildMs, frames, o.threads, runS);
   std::printf("  %-11s %9s %9s %9s\n", "stage", "median", "p95", "max");
   for (auto [name, s] : {std::pair<const char*, const Series*>{"frame", &total}, {"broadphase", &broad}, {"contacts", &contacts},
-                         {"solver", &solver}, {"integrate", &integrate}})
+                         {"solver", &solver}, {"integrate", &integrate}, {"rays", &rays}}) {
+    if (s == &rays && rayCount == 0) continue;
     std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
+  }
   std::printf("  per frame: %.0f pairs (%.0f reused from the pair cache), %.0f contacts, %.0f box tests\n", double(pairs) / frames,
               double(reused) / frames, double(contactCount) / frames, double(boxTests) / frames);
+  if (rayCount)
+    std::printf("  rays: %.0f per frame, %.1f%% hit, %.0f box tests per ray\n", double(rayCount) / frames,
+                100.0 * double(rayHits) / double(rayCount), double(rayBoxTests) / double(rayCount));
+  if (!scene.terrains.empty())
+    std::printf("  terrain: %.0f contacts per frame, %u bodies in water at the end\n", double(terrainContacts) / frames, floating);
   std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
               world.sleepingCount(), moving, std::isfinite(lowest) ? lowest : 0.0);
   std::printf("  peak memory %.0f MiB; state hash %016llx\n", peakResidentMiB(), (unsigned long long)world.stateHash());

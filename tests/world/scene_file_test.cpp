@@ -56,9 +56,9 @@ TEST(SceneFile, BadValuesNameTheFileTheFieldAndTheExpectation) {
   const BadCase cases[] = {
       {"{", "bad.json: not valid JSON"},
       {R"({"grids": []})", "bad.json: scene: missing required field 'name'"},
-      {R"({"name": "x"})", "declares no grids and no spawners"},
+      {R"({"name": "x"})", "declares no grids, spawners or terrains"},
       {R"({"name": "x", "grids": [{"name": "g", "generator": "castle"}]})", "scene.grids[0].generator: expected one of \"house\""},
-      {R"({"name": "x", "grids": [{"name": "g"}]})", "scene.grids[0]: needs exactly one of 'generator' or 'bricks'"},
+      {R"({"name": "x", "grids": [{"name": "g"}]})", "scene.grids[0]: needs exactly one of 'generator', 'file' or 'bricks'"},
       {R"({"name": "x", "grids": [{"name": "g", "bricks": []}]})", "scene.grids[0].bricks: is empty"},
       {R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0], "half_size": [1, 1, 1]}]}]})",
        "scene.grids[0].bricks[0].position: expected an array of 3 numbers"},
@@ -89,6 +89,21 @@ TEST(SceneFile, BadValuesNameTheFileTheFieldAndTheExpectation) {
        "scene.spawners[0].grid: expected the name of a grid declared"},
       {R"({"name": "x", "spawners": [{"shape": "box", "count": 1, "velocity": [1e300, 0, 0], "region": {"min": [0,0,0], "max": [1,1,1]}}]})",
        "scene.spawners[0].velocity[0]: expected a number in"},
+      {R"({"name": "x", "grids": [{"name": "g", "file": "nowhere/island.brs"}]})", "scene.grids[0].file: no such file: nowhere/island.brs"},
+      {R"({"name": "x", "grids": [{"name": "g", "file": "island.txt"}]})", "scene.grids[0].file: expected a path to a .brs file"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house", "tiles": [0, 2]}]})", "scene.grids[0].tiles[0]: expected an integer in 1..1000"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house", "tiles": [2]}]})", "scene.grids[0].tiles: expected [tiles along x, tiles along y]"},
+      {R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0, 0], "half_size": [1, 1, 1]}], "tiles": [2, 2]}]})",
+       "scene.grids[0].tiles: tiles apply to a generator or a file"},
+      {R"({"name": "x", "terrains": [{"name": "t", "file": "nowhere.vox"}]})", "scene.terrains[0].file: no such file: nowhere.vox"},
+      {R"({"name": "x", "terrains": [{"file": "a.vox"}]})", "scene.terrains[0]: missing required field 'name'"},
+      {R"({"name": "x", "settings": {"manifold_size": 0}, "grids": [{"name": "g", "generator": "house"}]})",
+       "scene.settings.manifold_size: expected an integer in 1..64, got 0"},
+      {R"({"name": "x", "settings": {"reuse_translation": -1}, "grids": [{"name": "g", "generator": "house"}]})",
+       "scene.settings.reuse_translation: expected a number in"},
+      {R"({"name": "x", "rays": {"count": -1}, "grids": [{"name": "g", "generator": "house"}]})", "scene.rays.count: expected an integer"},
+      {R"({"name": "x", "rays": {"count": 10, "direction": 1}, "grids": [{"name": "g", "generator": "house"}]})",
+       "scene.rays.direction: unknown field"},
   };
   for (const BadCase& c : cases) {
     try {
