@@ -14,12 +14,16 @@
 
 namespace bw {
 
-/// What collides for a body: a primitive, or a brick grid (index into the world's grids).
+/// What collides for a body: a primitive, a brick grid or a voxel terrain (indices into the
+/// world's grids and terrains).
 struct BodyShape {
-  QueryShape primitive;             ///< used when grid == kNoGrid
-  uint32_t grid = kNoGrid;
-  static constexpr uint32_t kNoGrid = 0xFFFFFFFFu;
-  bool isGrid() const { return grid != kNoGrid; }
+  QueryShape primitive;             ///< used when neither grid nor terrain is set
+  uint32_t grid = kNone;
+  uint32_t terrain = kNone;
+  static constexpr uint32_t kNone = 0xFFFFFFFFu;
+  static constexpr uint32_t kNoGrid = kNone;
+  bool isGrid() const { return grid != kNone; }
+  bool isTerrain() const { return terrain != kNone; }
 };
 
 struct BodyStore {

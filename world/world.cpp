@@ -11,6 +11,8 @@
 #include "collision/build_tiling.h"
 #include "collision/input_validation.h"
 #include "collision/seeded_random.h"
+#include "collision/terrain/terrain_contacts.h"
+#include "collision/terrain/vox_reader.h"
 #include "world/scene_file.h"
 
 namespace bw {
@@ -26,8 +28,15 @@ constexpr float kBaumgarte = 0.2f;
 constexpr float kSlop = 0.005f;
 constexpr float kRestitution = 0.1f;
 constexpr float kBounceThreshold = 1.0f;
+// Deep overlaps (bodies spawned inside each other or inside terrain) separate at most this fast
+// (m/s): Baumgarte alone would turn a 1 m overlap into a 12 m/s launch.
+constexpr float kMaxPushOut = 3.0f;
 // Sleeping: an island whose bodies all stayed below these speeds for kSleepTime seconds sleeps.
 constexpr float kSleepLinear = 0.05f, kSleepAngular = 0.1f, kSleepTime = 0.5f;
+// Water drag: velocities decay at this rate (1/s) times the submerged fraction, so floating
+// bodies settle instead of bobbing for ever (a crate of half water's density rises at about
+// g / kWaterLinearDrag = 2.5 m/s and does not leap out of the surface).
+constexpr float kWaterLinearDrag = 4.f, kWaterAngularDrag = 4.f;
 // Pair cache: contacts are reused while the relative pose moved less than these since they were
 // made (a resting pile moves micrometres per step).
 
@@ -76,6 +85,7 @@ uint64_t bitsOf(const T& v) {
 
 World::World(const SceneDescription& scene, int threads) : scene_(scene), jobs_(threads) {
   for (const GridDescription& g : scene_.grids) buildGrid(g);
+  for (const TerrainDescription& t : scene_.terrains) buildTerrain(t);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
   stillTime_.assign(bodies_.size(), 0.f);
   asleep_.assign(bodies_.size(), 0);
@@ -125,6 +135,29 @@ void World::buildGrid(const GridDescription& g) {
   grids_.push_back(std::move(grid));
   gridNames_.push_back(g.name);
   addGridBody(uint32_t(grids_.size() - 1), g.position, g.rotation, g.motion, g.kinematic.linearVelocity, g.kinematic.angularVelocity);
+}
+
+void World::buildTerrain(const TerrainDescription& t) {
+  VoxMaterialMap materials;
+  if (t.waterFirst >= 0) {
+    materials.waterFirst = t.waterFirst;
+    materials.waterLast = t.waterLast;
+  }
+  VoxTerrainOptions options;
+  options.voxelSize = t.voxelSize;
+  options.placement = RigidTransform{t.position, Quatf::Identity()};
+  VoxTerrain built;
+  try {
+    built = buildVoxTerrain(loadVox(t.file), materials, options);
+  } catch (const InvalidInput& e) {
+    throw SceneError(scene_.source + ": terrain '" + t.name + "': " + e.what());
+  }
+  BodyShape shape;
+  shape.terrain = uint32_t(terrains_.size());
+  terrains_.push_back(std::move(built.terrain));
+  waterDensity_.push_back(t.waterDensity);
+  const RigidTransform& placement = terrains_.back()->placement();
+  bodies_.add(placement.translation, placement.rotation, MotionType::Static, shape, 0.f, Vec3f::Zero());
 }
 
 uint32_t World::addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
@@ -191,8 +224,15 @@ void World::computeBounds() {
     const RigidTransform pose = bodies_.shapePose(i);
     const Mat3f R = pose.rotation.toRotationMatrix().cwiseAbs();
     Vec3d centre, half;
-    if (bodies_.shape[i].isGrid()) {
-      const Aabb b = grids_[bodies_.shape[i].grid]->bounds();
+    if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) {
+      Aabb b;
+      if (bodies_.shape[i].isGrid()) {
+        b = grids_[bodies_.shape[i].grid]->bounds();
+      } else {
+        const Terrain& t = *terrains_[bodies_.shape[i].terrain];
+        const Int3 size = t.voxels().size();
+        b = {Vec3f::Zero(), Vec3f(float(size.x), float(size.y), float(size.z)) * t.voxelSize()};
+      }
       centre = pose.pointToWorld(b.center());
       half = (R * b.halfExtent()).cast<double>();
     } else {
@@ -243,6 +283,7 @@ void World::generateContacts(float dt) {
       out.clear();
       uint32_t a = pairs_[k].a, b = pairs_[k].b;
       if (!canCollide(a, b) || (!active(a) && !active(b))) continue;  // nothing awake: nothing to do
+      if (bodies_.shape[a].isTerrain() || bodies_.shape[b].isTerrain()) continue;  // terrainPairs()
       const RigidTransform poseA{bodies_.position[a], bodies_.rotation[a]}, poseB{bodies_.position[b], bodies_.rotation[b]};
       if (pairCacheHit_[k] >= 0) {
         const PairCacheEntry& e = pairCache_[size_t(pairCacheHit_[k])];
@@ -293,6 +334,68 @@ void World::generateContacts(float dt) {
       }
     }
   });
+}
+
+// Pairs with a terrain, in pair order on this thread: solid contacts against the chunk
+// triangles, and buoyancy plus drag from the water voxels the body displaces.
+void World::terrainPairs(float dt) {
+  if (terrains_.empty()) return;
+  const uint32_t n = uint32_t(pairs_.size());
+  const Vec3f g = scene_.settings.gravity.cast<float>();
+  stats_.floating = 0;  // bodies in water in the last substep
+  for (uint32_t k = 0; k < n; ++k) {
+    const uint32_t a = pairs_[k].a, b = pairs_[k].b;
+    const bool terrainA = bodies_.shape[a].isTerrain();
+    if (!terrainA && !bodies_.shape[b].isTerrain()) continue;
+    if (!canCollide(a, b) || (!active(a) && !active(b))) continue;
+    const uint32_t body = terrainA ? b : a, terrainBody = terrainA ? a : b;
+    Terrain& terrain = *terrains_[bodies_.shape[terrainBody].terrain];
+    const RigidTransform pose = bodies_.shapePose(body);
+    TerrainContactShape shape;
+    const BodyShape& bs = bodies_.shape[body];
+    if (bs.isGrid()) {
+      // A grid meets terrain through its convex approximation (as it meets other grids).
+      const ConvexApproximation& hull = grids_[bs.grid]->convexApproximation(scene_.settings.approximationDepth);
+      const Vec3d centre = pose.pointToWorld(hull.shapeCenter());
+      shape = hull.isBox ? TerrainContactShape::box(centre, pose.rotation, hull.bounds.halfExtent())
+                         : TerrainContactShape::convexHull(centre, pose.rotation, hull.centered.data(), uint32_t(hull.centered.size()));
+    } else if (bs.primitive.kind == QueryShape::Kind::Sphere) {
+      shape = TerrainContactShape::sphere(pose.translation, bs.primitive.radius);
+    } else if (bs.primitive.kind == QueryShape::Kind::Capsule) {
+      // Our capsules run along local z, the terrain's along local y: turn y onto z.
+      const Quatf yToZ(Eigen::AngleAxisf(1.5707963f, Vec3f::UnitX()));
+      shape = TerrainContactShape::capsule(pose.translation, pose.rotation * yToZ, bs.primitive.halfHeight, bs.primitive.radius);
+    } else if (bs.primitive.kind == QueryShape::Kind::Box) {
+      shape = TerrainContactShape::box(pose.translation, pose.rotation, bs.primitive.halfExtents);
+    } else {
+      shape = TerrainContactShape::convexHull(pose.translation, pose.rotation, bs.primitive.points, bs.primitive.pointCount);
+    }
+    std::vector<Contact>& out = pairContacts_[k];
+    out.clear();
+    const float margin = 0.01f + bodies_.linearVelocity[body].norm() * dt;
+    terrainContacts(terrain, shape, margin, out);
+    pairFlipped_[k] = body == b;  // normals point from the terrain towards the body
+    stats_.terrainContacts += uint32_t(out.size());
+
+    WaterContact water;
+    if (bodies_.motion[body] != MotionType::Dynamic || !terrainWaterContact(terrain, shape, water)) continue;
+    // Archimedes: the displaced water's weight, applied at the centre of buoyancy, as an
+    // impulse this substep; then drag in proportion to how deep the body sits.
+    const float impulse = float(waterDensity_[bodies_.shape[terrainBody].terrain] * water.submergedVolume) * dt;
+    const Vec3f j = -g * impulse;
+    bodies_.linearVelocity[body] += j * bodies_.inverseMass[body];
+    // note: the centre of buoyancy is estimated from the body's bounding box, so only a body
+    // cut by the surface gets the righting torque; a submerged one would get a spurious torque
+    // wherever its box overlaps solid voxels (and spin up without bound).
+    if (water.submergedFraction < 0.98f) {
+      const Vec3f r = (water.centreOfBuoyancy - bodies_.position[body]).cast<float>();
+      bodies_.angularVelocity[body] += bodies_.inverseInertiaWorld(body) * r.cross(j);
+    }
+    const float f = water.submergedFraction;
+    bodies_.linearVelocity[body] *= std::max(0.f, 1.f - kWaterLinearDrag * f * dt);
+    bodies_.angularVelocity[body] *= std::max(0.f, 1.f - kWaterAngularDrag * f * dt);
+    ++stats_.floating;
+  }
 }
 
 // Stores every pair's contacts in both bodies' frames for the next step.
@@ -361,7 +464,8 @@ void World::prepareSolver(float dt) {
       const float vn = vRel.dot(n);
       // Penetrating: push out (Baumgarte) and restitute fast impacts. Speculative (a gap of -depth):
       // the bodies may approach by at most the gap this step.
-      s.bias = s.depth >= 0.f ? kBaumgarte / dt * std::max(s.depth - kSlop, 0.f) + (vn < -kBounceThreshold ? -kRestitution * vn : 0.f)
+      s.bias = s.depth >= 0.f ? std::min(kBaumgarte / dt * std::max(s.depth - kSlop, 0.f), kMaxPushOut) +
+                                    (vn < -kBounceThreshold ? -kRestitution * vn : 0.f)
                               : s.depth / dt;
       // Warm start from the nearest cached impulse of the same pair and feature.
       auto range = std::equal_range(cache_.begin(), cache_.end(), CachedImpulse{s.key, {}, 0, 0, 0},
@@ -544,6 +648,7 @@ void World::substep(float dt, int index) {
   {
     ProfileZone z(profiler_, "contacts (stage)");
     generateContacts(dt);
+    terrainPairs(dt);
     updatePairCache();
   }
   stats_.contactsMs += msSince(t);

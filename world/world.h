@@ -13,12 +13,14 @@
 /// sequential-impulse solver with friction, restitution and warm starting matched by contact
 /// feature, islands (union-find over contacts) solved in parallel, sleeping islands, and
 /// semi-implicit Euler integration with substeps. Not yet: splitting one huge island across
-/// threads, a pair cache, terrain (the scene schema has no terrain yet either).
+/// threads. Terrains (MagicaVoxel models) are static bodies whose pairs run on one thread (their
+/// chunk cache is filled by queries); water voxels float bodies (buoyancy and drag).
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "collision/brick_grid.h"
+#include "collision/terrain/terrain.h"
 #include "jobs/job_system.h"
 #include "jobs/profiler.h"
 #include "world/body_store.h"
@@ -39,7 +41,7 @@ struct StepStats {
   uint32_t rays = 0, rayHits = 0;
   uint64_t rayBoxTests = 0;
   uint32_t terrainContacts = 0;  ///< contacts against terrains (included in contacts)
-  uint32_t floating = 0;         ///< bodies touching water
+  uint32_t floating = 0;         ///< awake bodies touching water (last substep)
 };
 
 class World {
@@ -61,6 +63,11 @@ class World {
   uint64_t stateHash() const;
   /// Kinetic plus potential energy of the dynamic bodies (for drift checks).
   double energy() const;
+  /// Pairs of the last substep and each pair's contacts (normal from the pair's `a` side to
+  /// its `b` side unless pairContactsFlipped(k)); for tests and tools.
+  const std::vector<BodyPair>& pairs() const { return pairs_; }
+  const std::vector<Contact>& pairContacts(uint32_t k) const { return pairContacts_[k]; }
+  bool pairContactsFlipped(uint32_t k) const { return pairFlipped_[k] != 0; }
   /// Dynamic bodies currently asleep.
   uint32_t sleepingCount() const;
 
@@ -100,6 +107,8 @@ class World {
   std::vector<Brick> gridBricks(const GridDescription& g) const;
   void buildGrid(const GridDescription& g);
   void fireRays();
+  void buildTerrain(const TerrainDescription& t);
+  void terrainPairs(float dt);
   void spawn(const SpawnerDescription& s);
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
@@ -122,6 +131,10 @@ class World {
   Profiler profiler_;
   std::vector<std::unique_ptr<BrickGrid>> grids_;
   std::vector<std::string> gridNames_;
+  // Terrains are static bodies too. Their chunk cache is filled by queries (not thread-safe),
+  // so pairs with a terrain are collided on one thread after the parallel pairs.
+  std::vector<std::unique_ptr<Terrain>> terrains_;
+  std::vector<float> waterDensity_;
   BodyStore bodies_;
   std::vector<WorldAabb> bounds_;
   std::vector<uint8_t> isStatic_;
