@@ -12,6 +12,18 @@
 
 namespace bw {
 
+/// Accepted ranges of scene values: scene files are parsed against them and World validates a
+/// SceneDescription built in code against them (validateScene in scene_file.h).
+namespace scene_limits {
+constexpr double kMaxCoordinate = 1e9;   ///< |world coordinate| (double)
+constexpr double kMaxSpeed = 1e4;        ///< |velocity component|, m/s
+constexpr double kMaxAngularSpeed = 100; ///< |angular velocity component|, rad/s
+constexpr double kMinSize = 1e-3, kMaxSize = 1e4;        ///< primitive half extents and radii
+constexpr double kMinDensity = 1e-3, kMaxDensity = 1e5;  ///< kg/m^3 (no zero-mass dynamic bodies)
+constexpr double kMinTimestep = 1.0 / 10000, kMaxTimestep = 1.0 / 10;  ///< seconds per frame
+constexpr double kMaxGravity = 1000;     ///< |gravity component|, m/s^2
+}  // namespace scene_limits
+
 /// How a body moves.
 enum class MotionType : uint8_t { Static, Kinematic, Dynamic };
 

@@ -118,8 +118,8 @@ class Field {
   const std::string& file_;
 };
 
-constexpr double kMaxCoord = 1e9;      // world coordinates (double)
-constexpr double kMaxSpeed = 1e4;      // m/s accepted in scene files
+constexpr double kMaxCoord = scene_limits::kMaxCoordinate;
+constexpr double kMaxSpeed = scene_limits::kMaxSpeed;
 
 Brick parseBrick(const Field& f) {
   f.allowOnly({"position", "half_size", "shape", "rotation", "material", "filter", "sides"});
@@ -196,7 +196,7 @@ GridDescription parseGrid(const Field& f, const std::string& sceneSource) {
     if (g.motion != MotionType::Kinematic && g.motion != MotionType::Dynamic)
       f.failMessage("velocities need \"motion\": \"kinematic\" or \"dynamic\"");
     if (f.has("linear_velocity")) g.kinematic.linearVelocity = f.at("linear_velocity").vec3(-kMaxSpeed, kMaxSpeed);
-    if (f.has("angular_velocity")) g.kinematic.angularVelocity = f.at("angular_velocity").vec3(-100, 100).cast<float>();
+    if (f.has("angular_velocity")) g.kinematic.angularVelocity = f.at("angular_velocity").vec3(-scene_limits::kMaxAngularSpeed, scene_limits::kMaxAngularSpeed).cast<float>();
   }
   return g;
 }
@@ -216,10 +216,11 @@ SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescriptio
     if (std::none_of(grids.begin(), grids.end(), [&](const GridDescription& d) { return d.name == s.grid; }))
       g.fail("the name of a grid declared in \"grids\"");
   }
-  if (f.has("half_extents")) s.halfExtents = f.at("half_extents").vec3(1e-3, 1e4).cast<float>();
-  if (f.has("radius")) s.radius = float(f.at("radius").number(1e-3, 1e4));
-  if (f.has("half_height")) s.halfHeight = float(f.at("half_height").number(0, 1e4));
-  if (f.has("density")) s.density = float(f.at("density").number(1e-3, 1e5));
+  using namespace scene_limits;
+  if (f.has("half_extents")) s.halfExtents = f.at("half_extents").vec3(kMinSize, kMaxSize).cast<float>();
+  if (f.has("radius")) s.radius = float(f.at("radius").number(kMinSize, kMaxSize));
+  if (f.has("half_height")) s.halfHeight = float(f.at("half_height").number(0, kMaxSize));
+  if (f.has("density")) s.density = float(f.at("density").number(kMinDensity, kMaxDensity));
   const Field region = f.at("region");
   region.allowOnly({"min", "max"});
   s.regionMin = region.at("min").vec3(-kMaxCoord, kMaxCoord);
@@ -235,8 +236,8 @@ SceneSettings parseSettings(const Field& f) {
   f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping",
                "manifold_size", "reuse_translation", "reuse_rotation"});
   SceneSettings s;
-  if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-1000, 1000);
-  if (f.has("timestep")) s.timestep = f.at("timestep").number(1.0 / 10000, 1.0 / 10);
+  if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-scene_limits::kMaxGravity, scene_limits::kMaxGravity);
+  if (f.has("timestep")) s.timestep = f.at("timestep").number(scene_limits::kMinTimestep, scene_limits::kMaxTimestep);
   if (f.has("substeps")) s.substeps = int(f.at("substeps").integer(1, 64));
   if (f.has("solver_iterations")) s.solverIterations = int(f.at("solver_iterations").integer(1, 256));
   if (f.has("frames")) s.frames = uint32_t(f.at("frames").integer(1, 10'000'000));

@@ -14,6 +14,7 @@
 #include "collision/terrain/terrain_contacts.h"
 #include "collision/terrain/vox_reader.h"
 #include "world/scene_file.h"
+#include "world/scene_validation.h"
 
 namespace bw {
 
@@ -83,7 +84,7 @@ uint64_t bitsOf(const T& v) {
 
 }  // namespace
 
-World::World(const SceneDescription& scene, int threads) : scene_(scene), jobs_(threads) {
+World::World(const SceneDescription& scene, int threads) : scene_((validateScene(scene), scene)), jobs_(threads) {
   for (const GridDescription& g : scene_.grids) buildGrid(g);
   for (const TerrainDescription& t : scene_.terrains) buildTerrain(t);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);

@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
+#include <limits>
+
+#include "world/world.h"
 
 namespace bw {
 namespace {
@@ -135,6 +139,65 @@ TEST(SceneFile, ShippedScenesParse) {
     ++n;
   }
   EXPECT_GE(n, 6);
+}
+
+}  // namespace
+}  // namespace bw
+
+namespace bw {
+namespace {
+
+// A SceneDescription built in code gets the same checks as a file: World refuses it before
+// building anything, naming the field.
+TEST(SceneValidation, BadValuesInCodeAreRefusedByTheWorld) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  SceneDescription base;
+  base.name = "api";
+  base.spawners.resize(1);
+  base.spawners[0].count = 1;
+  struct Case {
+    std::function<void(SceneDescription&)> spoil;
+    const char* expected;
+  };
+  const std::vector<Case> cases = {
+      {[&](SceneDescription& s) { s.spawners[0].regionMin.x() = nan; }, "scene 'api': spawners[0].region.min[0]: expected a number"},
+      {[&](SceneDescription& s) { s.spawners[0].velocity.z() = inf; }, "spawners[0].velocity[2]: expected a number"},
+      {[&](SceneDescription& s) { s.spawners[0].density = 0; }, "spawners[0].density: expected a number in [0.001, 100000], got 0"},
+      {[&](SceneDescription& s) { s.spawners[0].radius = -1; }, "spawners[0].radius: expected a number"},
+      {[&](SceneDescription& s) { s.spawners[0].halfExtents.y() = 0; }, "spawners[0].half_extents[1]: expected a number"},
+      {[&](SceneDescription& s) { s.settings.timestep = nan; }, "settings.timestep: expected a number"},
+      {[&](SceneDescription& s) { s.settings.timestep = 0; }, "settings.timestep: expected a number"},
+      {[&](SceneDescription& s) { s.settings.solverIterations = 0; }, "settings.solver_iterations"},
+      {[&](SceneDescription& s) { s.settings.gravity.x() = nan; }, "settings.gravity[0]"},
+      {[&](SceneDescription& s) { s.spawners[0].regionMin.z() = 2; s.spawners[0].regionMax.z() = 1; }, "spawners[0].region: min.z is greater than max.z"},
+      {[&](SceneDescription& s) {
+         s.grids.resize(1);
+         s.grids[0].name = "g";
+         s.grids[0].generator = "house";
+         s.grids[0].position.y() = 1e12;
+       }, "grids[0].position[1]: expected a number"},
+      {[&](SceneDescription& s) {
+         s.grids.resize(1);
+         s.grids[0].name = "g";
+         s.grids[0].generator = "house";
+         s.grids[0].rotation = Quatf(2, 0, 0, 0);
+       }, "grids[0].rotation: expected a unit quaternion"},
+      {[&](SceneDescription& s) {
+         s.spawners[0].shape = SpawnerDescription::Shape::Grid;
+         s.spawners[0].grid = "missing";
+       }, "spawners[0].grid: expected the name of a grid"},
+  };
+  EXPECT_NO_THROW(World(base, 1)) << "the unspoilt scene is valid";
+  for (const Case& c : cases) {
+    SceneDescription s = base;
+    c.spoil(s);
+    try {
+      World world(s, 1);
+      ADD_FAILURE() << "accepted a scene that should fail with: " << c.expected;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

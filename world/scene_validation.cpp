@@ -1,0 +1,106 @@
+#include "world/scene_validation.h"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "world/scene_file.h"
+
+namespace bw {
+
+namespace {
+
+using namespace scene_limits;
+
+class Checker {
+ public:
+  explicit Checker(const SceneDescription& s)
+      : prefix_(s.source.empty() ? "scene '" + s.name + "'" : s.source) {}
+
+  void number(const std::string& field, double v, double lo, double hi) const {
+    if (!(std::isfinite(v) && v >= lo && v <= hi)) fail(field, v, lo, hi);
+  }
+  template <class V>
+  void vector(const std::string& field, const V& v, double lo, double hi) const {
+    for (int i = 0; i < int(v.size()); ++i) number(field + "[" + std::to_string(i) + "]", double(v[i]), lo, hi);
+  }
+  void unitQuaternion(const std::string& field, const Quatf& q) const {
+    const double n = double(q.norm());
+    if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-3) {
+      std::ostringstream m;
+      m << prefix_ << ": " << field << ": expected a unit quaternion, got norm " << n;
+      throw SceneError(m.str());
+    }
+  }
+  [[noreturn]] void message(const std::string& field, const std::string& what) const {
+    throw SceneError(prefix_ + ": " + field + ": " + what);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& field, double v, double lo, double hi) const {
+    std::ostringstream m;
+    m << prefix_ << ": " << field << ": expected a number in [" << lo << ", " << hi << "], got " << v;
+    throw SceneError(m.str());
+  }
+  std::string prefix_;
+};
+
+}  // namespace
+
+void validateScene(const SceneDescription& scene) {
+  const Checker c(scene);
+  const SceneSettings& s = scene.settings;
+  c.vector("settings.gravity", s.gravity, -kMaxGravity, kMaxGravity);
+  c.number("settings.timestep", s.timestep, kMinTimestep, kMaxTimestep);
+  c.number("settings.substeps", s.substeps, 1, 64);
+  c.number("settings.solver_iterations", s.solverIterations, 1, 256);
+  c.number("settings.lod_fraction", s.lodFraction, 0, 1);
+  c.number("settings.approximation_depth", s.approximationDepth, 0, 7);
+  c.number("settings.manifold_size", s.manifoldSize, 1, 64);
+  c.number("settings.reuse_translation", s.reuseTranslation, 0, 1);
+  c.number("settings.reuse_rotation", s.reuseRotation, 0, 1);
+  for (size_t i = 0; i < scene.grids.size(); ++i) {
+    const GridDescription& g = scene.grids[i];
+    const std::string f = "grids[" + std::to_string(i) + "]";
+    if (g.name.empty()) c.message(f + ".name", "expected a non-empty name");
+    c.number(f + ".scale", g.scale, 0.001, 64);
+    c.number(f + ".tiles[0]", g.tilesX, 1, 1000);
+    c.number(f + ".tiles[1]", g.tilesY, 1, 1000);
+    c.number(f + ".tile_gap", g.tileGap, 0, 1e5);
+    c.vector(f + ".position", g.position, -kMaxCoordinate, kMaxCoordinate);
+    c.unitQuaternion(f + ".rotation", g.rotation);
+    c.vector(f + ".linear_velocity", g.kinematic.linearVelocity, -kMaxSpeed, kMaxSpeed);
+    c.vector(f + ".angular_velocity", g.kinematic.angularVelocity, -kMaxAngularSpeed, kMaxAngularSpeed);
+    if (g.generator.empty() && g.file.empty() && g.bricks.empty()) c.message(f, "has no generator, file or bricks");
+  }
+  for (size_t i = 0; i < scene.spawners.size(); ++i) {
+    const SpawnerDescription& sp = scene.spawners[i];
+    const std::string f = "spawners[" + std::to_string(i) + "]";
+    c.number(f + ".count", sp.count, 0, 1'000'000);
+    c.vector(f + ".half_extents", sp.halfExtents, kMinSize, kMaxSize);
+    c.number(f + ".radius", sp.radius, kMinSize, kMaxSize);
+    c.number(f + ".half_height", sp.halfHeight, 0, kMaxSize);
+    c.number(f + ".density", sp.density, kMinDensity, kMaxDensity);
+    c.vector(f + ".region.min", sp.regionMin, -kMaxCoordinate, kMaxCoordinate);
+    c.vector(f + ".region.max", sp.regionMax, -kMaxCoordinate, kMaxCoordinate);
+    for (int k = 0; k < 3; ++k)
+      if (sp.regionMin[k] > sp.regionMax[k]) c.message(f + ".region", std::string("min.") + "xyz"[k] + " is greater than max." + "xyz"[k]);
+    c.vector(f + ".velocity", sp.velocity, -kMaxSpeed, kMaxSpeed);
+    if (sp.shape == SpawnerDescription::Shape::Grid) {
+      bool found = false;
+      for (const GridDescription& g : scene.grids) found = found || g.name == sp.grid;
+      if (!found) c.message(f + ".grid", "expected the name of a grid declared in grids, got '" + sp.grid + "'");
+    }
+  }
+  for (size_t i = 0; i < scene.terrains.size(); ++i) {
+    const TerrainDescription& t = scene.terrains[i];
+    const std::string f = "terrains[" + std::to_string(i) + "]";
+    c.number(f + ".voxel_size", t.voxelSize, 1e-3, 1e3);
+    c.vector(f + ".position", t.position, -kMaxCoordinate, kMaxCoordinate);
+    c.number(f + ".water_density", t.waterDensity, 1, 1e5);
+    if (t.waterFirst >= 0 && (t.waterFirst > t.waterLast || t.waterLast > 255)) c.message(f + ".water", "expected 1 <= first <= last <= 255");
+  }
+  c.number("rays.length", scene.rays.length, 0, 1e7);
+}
+
+}  // namespace bw
