@@ -399,6 +399,28 @@ void World::terrainPairs(float dt) {
   }
 }
 
+const std::vector<std::vector<Contact>>& World::probeContacts(float lodFraction, int approximationDepth, int manifoldSize,
+                                                             uint64_t* boxTests) {
+  const SceneSettings saved = scene_.settings;
+  scene_.settings.lodFraction = lodFraction;
+  scene_.settings.approximationDepth = approximationDepth;
+  scene_.settings.manifoldSize = manifoldSize;
+  scene_.settings.reuseTranslation = 0;  // nothing counts as still: every pair is collided
+  try {
+    validateScene(scene_);
+    generateContacts(float(scene_.settings.timestep / scene_.settings.substeps));
+  } catch (...) {
+    scene_.settings = saved;
+    throw;
+  }
+  scene_.settings = saved;
+  if (boxTests) {
+    *boxTests = 0;
+    for (const ContactStats& s : pairStats_) *boxTests += s.index.boxTests;
+  }
+  return pairContacts_;
+}
+
 // Stores every pair's contacts in both bodies' frames for the next step.
 void World::updatePairCache() {
   nextPairCache_.clear();

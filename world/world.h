@@ -59,6 +59,9 @@ class World {
   uint64_t brickCount() const;
   /// The world's grids (shared by every body that is a copy of them).
   const BrickGrid& grid(uint32_t index) const { return *grids_[index]; }
+  /// A grid to edit (place or remove bricks) between steps; every body using it sees the edit
+  /// at the next step. Not while step() runs.
+  BrickGrid& editGrid(uint32_t index) { return *grids_[index]; }
   /// Hash of every body's position, rotation and velocities (bit patterns).
   uint64_t stateHash() const;
   /// Kinetic plus potential energy of the dynamic bodies (for drift checks).
@@ -68,6 +71,13 @@ class World {
   const std::vector<BodyPair>& pairs() const { return pairs_; }
   const std::vector<Contact>& pairContacts(uint32_t k) const { return pairContacts_[k]; }
   bool pairContactsFlipped(uint32_t k) const { return pairFlipped_[k] != 0; }
+  /// The contacts of the last substep's pairs made again on the current state with other
+  /// contact settings, the pair cache bypassed (for accuracy measurements: `brickworld
+  /// tradeoff` compares LOD against LOD off at the same state). Pairs with a terrain are left
+  /// empty (their query fills the terrain's cache and applies buoyancy). The world's state is
+  /// unchanged; the next step() makes its own contacts again. Returns one list per pair().
+  const std::vector<std::vector<Contact>>& probeContacts(float lodFraction, int approximationDepth, int manifoldSize,
+                                                         uint64_t* boxTests = nullptr);
   /// Dynamic bodies currently asleep.
   uint32_t sleepingCount() const;
 
