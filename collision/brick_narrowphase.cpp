@@ -214,6 +214,46 @@ bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f
   });
 }
 
+namespace {
+
+// A speculative (separated) box-box contact from GJK is one closest point, and a tilted box that
+// just touches has one or two. A tilted box closing on a thin plate faster than its size per
+// step then has one contact: the solver stops that corner and the box turns about it, so its far
+// corners swing through the plate within the step. The box's other corners facing the brick
+// within the margin get their own contacts (each with its own gap along the first contact's
+// normal) while their projection lies on the brick's box, so the whole face is held back.
+// Appends to out[0, count); returns the new count (at most kMaxContactsPerBrick).
+int addSpeculativeCorners(const QueryShape& shape, const btTransform& trShape, const Brick& b, const btTransform& trBrick,
+                          float margin, LocalContact* out, int count) {
+  const Vec3f n = out[0].normal, onBrick = out[0].position;  // on the brick's face
+  struct Corner {
+    float gap;
+    Vec3f point;
+  };
+  Corner corners[8];
+  int found = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3f local((i & 1) ? shape.halfExtents.x() : -shape.halfExtents.x(), (i & 2) ? shape.halfExtents.y() : -shape.halfExtents.y(),
+                      (i & 4) ? shape.halfExtents.z() : -shape.halfExtents.z());
+    const Vec3f v = fromBt(trShape * bt(local));
+    const float gap = (v - onBrick).dot(n);
+    if (gap >= margin || gap < 0.f) continue;  // out of reach, or penetrating (the detector's)
+    const Vec3f onFace = v - n * gap;
+    // On the brick's box (a little slack for rounding)?
+    const Vec3f inBrick = fromBt(trBrick.invXform(bt(onFace)));
+    if ((inBrick.cwiseAbs().array() > b.halfSize.array() + 1e-3f * (1.f + b.halfSize.maxCoeff())).any()) continue;
+    const float slack = 1e-3f * (1.f + shape.halfExtents.maxCoeff());
+    if (std::any_of(out, out + count, [&](const LocalContact& c) { return (c.position - onFace).norm() < slack; })) continue;
+    corners[found++] = {gap, onFace};
+  }
+  std::sort(corners, corners + found, [](const Corner& x, const Corner& y) { return x.gap < y.gap; });
+  for (int i = 0; i < found && count < kMaxContactsPerBrick; ++i)
+    out[count++] = {corners[i].point, n, -corners[i].gap, out[0].feature, out[0].material};
+  return count;
+}
+
+}  // namespace
+
 int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
                       float speculativeMargin, LocalContact* out) {
   const btTransform trShape = poseTransform(pose);
@@ -231,12 +271,17 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
     det.getClosestPoints(in, col, nullptr);
     // Touching boxes keep the detector's full manifold; separated ones fall through to GJK for
     // a speculative point when a margin is asked for.
+    if (col.count > 0 && col.count < kMaxContactsPerBrick && speculativeMargin > 0.f)
+      return addSpeculativeCorners(shape, trShape, b, trBrick, speculativeMargin, out, col.count);
     if (col.count > 0 || speculativeMargin <= 0.f) return col.count;
   }
   BrickPointCloud cloud(b);
-  return withBulletShape(shape, [&](btConvexShape& s) {
+  const int n = withBulletShape(shape, [&](btConvexShape& s) {
     return gjkEpa(s, trShape, cloud.shape, trBrick, feature, b.material, speculativeMargin, out);
   });
+  if (n == 1 && out[0].depth < 0.f && shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box)
+    return addSpeculativeCorners(shape, trShape, b, trBrick, speculativeMargin, out, 1);
+  return n;
 }
 
 int reduceManifold(LocalContact* c, int n, int maxOut) {

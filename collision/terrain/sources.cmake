@@ -11,4 +11,5 @@ set(BW_TERRAIN_SOURCES
   ${CMAKE_CURRENT_LIST_DIR}/triangle_contacts.cpp
   ${CMAKE_CURRENT_LIST_DIR}/terrain_contacts.cpp
   ${CMAKE_CURRENT_LIST_DIR}/terrain_generator.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/vox_reader.cpp
 )

@@ -1,6 +1,7 @@
-// `brickworld inspect FILE`: load a content file, put it into a brick grid and print what it
-// became: counts per asset and per shape, bounds, and the OctoBVH's shape and memory, so the
-// real builds can be compared with the seeded generators.
+// `brickworld inspect FILE`: load a content file and print what it became. A .brs save goes into
+// a brick grid (counts per asset and per shape, bounds, the OctoBVH's shape and memory, so the
+// real builds can be compared with the seeded generators); a .vox model goes into a voxel terrain
+// (models, voxel counts per palette index, water, bounds, chunk and broadphase counts).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -9,10 +10,14 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "cli/command_registry.h"
 #include "collision/brick_grid.h"
 #include "collision/brs_reader.h"
+#include "collision/input_validation.h"
+#include "collision/terrain/vox_reader.h"
 
 namespace bw::cli {
 namespace {
@@ -103,19 +108,170 @@ int inspectBrs(const std::string& path, bool json) {
   return 0;
 }
 
-CommandRegistration reg{"inspect", "Load a content file (.brs) into a brick grid and print counts, bounds and index shape",
+// The material map for a .vox file: --materials FILE, else --water FIRST LAST, else monu6's
+// documented default for a file named monu6.vox, else no water.
+struct VoxMapChoice {
+  VoxMaterialMap map;
+  std::string source;
+};
+
+VoxMapChoice chooseVoxMap(const std::string& path, const std::string& mapFile, const std::vector<int>& water) {
+  if (!mapFile.empty()) return {loadVoxMaterialMap(mapFile), "mapping file " + mapFile};
+  if (water.size() == 2) {
+    if (water[0] < 1 || water[1] > 255 || water[1] < water[0])
+      throw InvalidInput("brickworld inspect: --water " + std::to_string(water[0]) + " " + std::to_string(water[1]) +
+                         " is not a palette range within [1, 255]");
+    VoxMaterialMap m;
+    m.waterFirst = water[0];
+    m.waterLast = water[1];
+    return {m, "--water"};
+  }
+  if (std::filesystem::path(path).filename() == "monu6.vox") return {VoxMaterialMap::monu6(), "monu6 default"};
+  return {VoxMaterialMap{}, "none"};
+}
+
+int inspectVox(const std::string& path, bool json, const std::string& mapFile, const std::vector<int>& water,
+               size_t topN) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const VoxModelSet set = loadVox(path);
+  const double loadMs = msSince(t0);
+  const VoxMapChoice choice = chooseVoxMap(path, mapFile, water);
+
+  const auto t1 = std::chrono::steady_clock::now();
+  const VoxTerrain vt = buildVoxTerrain(set, choice.map);
+  const double buildMs = msSince(t1);
+  const Terrain& terrain = *vt.terrain;
+
+  std::vector<std::pair<int, uint64_t>> perIndex;
+  for (int i = 1; i < 256; ++i)
+    if (set.paletteCounts[size_t(i)] != 0) perIndex.emplace_back(i, set.paletteCounts[size_t(i)]);
+  std::stable_sort(perIndex.begin(), perIndex.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  const size_t usedIndices = perIndex.size();
+  if (perIndex.size() > topN) perIndex.resize(topN);
+  uint64_t waterInFile = 0;
+  for (int i = 1; i < 256; ++i)
+    if (choice.map.isWater(uint8_t(i))) waterInFile += set.paletteCounts[size_t(i)];
+  const bool hasWaterRange = choice.map.waterFirst <= choice.map.waterLast;
+  const Int3& bmin = set.boundsMin;
+  const Int3& bmax = set.boundsMax;
+  const Int3& vmin = set.voxelBoundsMin;
+  const Int3& vmax = set.voxelBoundsMax;
+  const Int3& tsize = terrain.voxels().size();
+  const Int3& grid = terrain.voxels().chunkGrid();
+
+  if (json) {
+    nlohmann::json j;
+    j["file"] = path;
+    j["format"] = "vox";
+    j["version"] = set.version;
+    j["default_palette"] = set.defaultPalette;
+    j["scene_graph"] = set.hasSceneGraph;
+    nlohmann::json models = nlohmann::json::array();
+    for (const VoxModel& m : set.models)
+      models.push_back({{"size", {m.size.x, m.size.y, m.size.z}}, {"voxels", m.voxels.size()}});
+    j["models"] = models;
+    nlohmann::json instances = nlohmann::json::array();
+    for (const VoxInstance& inst : set.instances)
+      instances.push_back({{"model", inst.model},
+                           {"translation", {inst.translation.x, inst.translation.y, inst.translation.z}},
+                           {"offset", {inst.offset.x, inst.offset.y, inst.offset.z}},
+                           {"rotation_ignored", inst.rotationIgnored}});
+    j["instances"] = instances;
+    j["file_voxels"] = set.fileVoxels;
+    j["total_voxels"] = set.totalVoxels;
+    j["transforms_applied"] = set.transformsApplied;
+    j["ignored_rotations"] = set.ignoredRotations;
+    j["skipped_chunks"] = set.skippedChunks;
+    j["palette_indices_used"] = usedIndices;
+    nlohmann::json top = nlohmann::json::array();
+    for (const auto& [index, n] : perIndex) {
+      const VoxRgba c = set.palette[size_t(index)];
+      top.push_back({{"index", index}, {"voxels", n}, {"rgba", {c.r, c.g, c.b, c.a}}});
+    }
+    j["palette_counts_top"] = top;
+    j["material_map"] = choice.source;
+    if (hasWaterRange) j["water_range"] = {choice.map.waterFirst, choice.map.waterLast};
+    j["water_voxels"] = waterInFile;
+    if (bmin.x <= bmax.x) {
+      j["bounds_min"] = {bmin.x, bmin.y, bmin.z};
+      j["bounds_max"] = {bmax.x, bmax.y, bmax.z};
+    }
+    if (vmin.x <= vmax.x) {
+      j["voxel_bounds_min"] = {vmin.x, vmin.y, vmin.z};
+      j["voxel_bounds_max"] = {vmax.x, vmax.y, vmax.z};
+    }
+    j["load_ms"] = loadMs;
+    j["build_ms"] = buildMs;
+    j["terrain"] = {{"size", {tsize.x, tsize.y, tsize.z}},
+                    {"chunk_grid", {grid.x, grid.y, grid.z}},
+                    {"vox_to_terrain", {vt.voxToTerrain.x, vt.voxToTerrain.y, vt.voxToTerrain.z}},
+                    {"solid_voxels", vt.solidVoxels},
+                    {"water_voxels", vt.waterVoxels},
+                    {"skipped_voxels", vt.skippedVoxels},
+                    {"stored_chunks", terrain.voxels().storedChunkCount()},
+                    {"voxel_bytes", terrain.voxels().residentBytes()},
+                    {"broadphase_entries", terrain.broadphase().entryCount()},
+                    {"broadphase_masked", terrain.broadphase().maskedCount()},
+                    {"broadphase_bytes", terrain.broadphase().bytes()}};
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+
+  std::printf("%s: MagicaVoxel model, version %d, %s palette%s\n", path.c_str(), set.version,
+              set.defaultPalette ? "default" : "own", set.hasSceneGraph ? ", scene graph" : "");
+  std::printf("  models      %zu, instances %zu, transforms applied %u, rotations ignored %u, chunks skipped %u\n",
+              set.models.size(), set.instances.size(), set.transformsApplied, set.ignoredRotations, set.skippedChunks);
+  for (size_t i = 0; i < set.models.size() && i < 16; ++i)
+    std::printf("    model %-4zu %d x %d x %d, %zu voxels\n", i, set.models[i].size.x, set.models[i].size.y,
+                set.models[i].size.z, set.models[i].voxels.size());
+  if (set.models.size() > 16) std::printf("    ... %zu more\n", set.models.size() - 16);
+  std::printf("  voxels      %llu placed (%llu in the file), %zu palette indices used\n",
+              (unsigned long long)set.totalVoxels, (unsigned long long)set.fileVoxels, usedIndices);
+  std::printf("  load        %.1f ms (read + parse + place), building the terrain %.1f ms\n", loadMs, buildMs);
+  if (bmin.x <= bmax.x)
+    std::printf("  bounds      (%d, %d, %d) .. (%d, %d, %d), %d x %d x %d voxels (model boxes)\n", bmin.x, bmin.y, bmin.z,
+                bmax.x, bmax.y, bmax.z, bmax.x - bmin.x + 1, bmax.y - bmin.y + 1, bmax.z - bmin.z + 1);
+  if (vmin.x <= vmax.x)
+    std::printf("              (%d, %d, %d) .. (%d, %d, %d), %d x %d x %d voxels (occupied)\n", vmin.x, vmin.y, vmin.z,
+                vmax.x, vmax.y, vmax.z, vmax.x - vmin.x + 1, vmax.y - vmin.y + 1, vmax.z - vmin.z + 1);
+  if (hasWaterRange)
+    std::printf("  water       palette %d..%d (%s): %llu voxels\n", choice.map.waterFirst, choice.map.waterLast,
+                choice.source.c_str(), (unsigned long long)waterInFile);
+  else
+    std::printf("  water       %llu voxels (material map: %s; give --water FIRST LAST)\n",
+                (unsigned long long)waterInFile, choice.source.c_str());
+  std::printf("  per palette index (top %zu)\n", perIndex.size());
+  for (const auto& [index, n] : perIndex) {
+    const VoxRgba c = set.palette[size_t(index)];
+    std::printf("    %3d  rgba(%3d, %3d, %3d, %3d) %s %10llu\n", index, c.r, c.g, c.b, c.a,
+                choice.map.isWater(uint8_t(index)) ? "water" : "     ", (unsigned long long)n);
+  }
+  std::printf("  terrain     %d x %d x %d voxels (%d x %d x %d chunks), %u chunks stored, %.1f KiB of voxels\n", tsize.x,
+              tsize.y, tsize.z, grid.x, grid.y, grid.z, terrain.voxels().storedChunkCount(),
+              double(terrain.voxels().residentBytes()) / 1024.0);
+  std::printf("              %llu solid, %llu water, %llu skipped voxels written\n", (unsigned long long)vt.solidVoxels,
+              (unsigned long long)vt.waterVoxels, (unsigned long long)vt.skippedVoxels);
+  std::printf("  broadphase  %zu chunk entries, %zu with masks, %.1f KiB\n", terrain.broadphase().entryCount(),
+              terrain.broadphase().maskedCount(), double(terrain.broadphase().bytes()) / 1024.0);
+  return 0;
+}
+
+CommandRegistration reg{"inspect",
+                        "Load a content file (.brs into a brick grid, .vox into a voxel terrain) and print counts, "
+                        "bounds and index shape",
                         [](CLI::App& cmd) {
   auto file = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
-  cmd.add_option("file", *file, "a Brickadia save (.brs)")->required();
+  auto materials = std::make_shared<std::string>();
+  auto water = std::make_shared<std::vector<int>>();
+  auto top = std::make_shared<size_t>(16);
+  cmd.add_option("file", *file, "a Brickadia save (.brs) or a MagicaVoxel model (.vox)")->required();
   cmd.add_flag("--json", *json, "print one JSON object");
+  cmd.add_option("--water", *water, ".vox: palette indices FIRST LAST that are water")->expected(2);
+  cmd.add_option("--materials", *materials, ".vox: a JSON palette -> material mapping file (see vox_reader.h)");
+  cmd.add_option("--top", *top, ".vox: palette indices listed, most used first")->capture_default_str();
   return [=] {
-    const std::string ext = lowerExtension(*file);
-    if (ext == ".vox") {
-      std::cerr << "brickworld inspect: " << *file
-                << ": .vox (MagicaVoxel terrain) inspection is not available yet; only .brs saves can be inspected\n";
-      return 2;
-    }
+    if (lowerExtension(*file) == ".vox") return inspectVox(*file, *json, *materials, *water, *top);
     return inspectBrs(*file, *json);
   };
 }};
