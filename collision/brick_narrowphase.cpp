@@ -121,6 +121,8 @@ int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConve
 
 
 namespace {
+int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB, const btTransform& trB, uint32_t feature,
+                 uint32_t material, float speculativeMargin, LocalContact* out);
 
 // Runs f(btConvexShape&) with the query shape as a Bullet shape (no allocation).
 template <class F>
@@ -155,6 +157,8 @@ auto withBulletShape(const QueryShape& shape, F&& f) {
 
 int collideShapes(const QueryShape& a, const LocalPose& poseA, const QueryShape& b, const LocalPose& poseB,
                   float speculativeMargin, LocalContact* out) {
+  if (a.kind == QueryShape::Kind::Box && b.kind == QueryShape::Kind::Box)
+    return collideBoxes(a.halfExtents, poseTransform(poseA), b.halfExtents, poseTransform(poseB), 0, 0, speculativeMargin, out);
   return withBulletShape(a, [&](btConvexShape& sa) {
     return withBulletShape(b, [&](btConvexShape& sb) {
       return gjkEpa(sa, poseTransform(poseA), sb, poseTransform(poseB), 0, 0, speculativeMargin, out);
@@ -223,9 +227,9 @@ namespace {
 // within the margin get their own contacts (each with its own gap along the first contact's
 // normal) while their projection lies on the brick's box, so the whole face is held back.
 // Appends to out[0, count); returns the new count (at most kMaxContactsPerBrick).
-int addSpeculativeCorners(const QueryShape& shape, const btTransform& trShape, const Brick& b, const btTransform& trBrick,
-                          float margin, LocalContact* out, int count) {
-  const Vec3f n = out[0].normal, onBrick = out[0].position;  // on the brick's face
+int addSpeculativeCorners(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB, const btTransform& trB, float margin,
+                          LocalContact* out, int count) {
+  const Vec3f n = out[0].normal, onBrick = out[0].position;  // on b's face
   struct Corner {
     float gap;
     Vec3f point;
@@ -233,16 +237,15 @@ int addSpeculativeCorners(const QueryShape& shape, const btTransform& trShape, c
   Corner corners[8];
   int found = 0;
   for (int i = 0; i < 8; ++i) {
-    const Vec3f local((i & 1) ? shape.halfExtents.x() : -shape.halfExtents.x(), (i & 2) ? shape.halfExtents.y() : -shape.halfExtents.y(),
-                      (i & 4) ? shape.halfExtents.z() : -shape.halfExtents.z());
-    const Vec3f v = fromBt(trShape * bt(local));
+    const Vec3f local((i & 1) ? halfA.x() : -halfA.x(), (i & 2) ? halfA.y() : -halfA.y(), (i & 4) ? halfA.z() : -halfA.z());
+    const Vec3f v = fromBt(trA * bt(local));
     const float gap = (v - onBrick).dot(n);
     if (gap >= margin || gap < 0.f) continue;  // out of reach, or penetrating (the detector's)
     const Vec3f onFace = v - n * gap;
-    // On the brick's box (a little slack for rounding)?
-    const Vec3f inBrick = fromBt(trBrick.invXform(bt(onFace)));
-    if ((inBrick.cwiseAbs().array() > b.halfSize.array() + 1e-3f * (1.f + b.halfSize.maxCoeff())).any()) continue;
-    const float slack = 1e-3f * (1.f + shape.halfExtents.maxCoeff());
+    // On b's box (a little slack for rounding)?
+    const Vec3f inB = fromBt(trB.invXform(bt(onFace)));
+    if ((inB.cwiseAbs().array() > halfB.array() + 1e-3f * (1.f + halfB.maxCoeff())).any()) continue;
+    const float slack = 1e-3f * (1.f + halfA.maxCoeff());
     if (std::any_of(out, out + count, [&](const LocalContact& c) { return (c.position - onFace).norm() < slack; })) continue;
     corners[found++] = {gap, onFace};
   }
@@ -252,36 +255,46 @@ int addSpeculativeCorners(const QueryShape& shape, const btTransform& trShape, c
   return count;
 }
 
+// Box a against box b: Bullet's box-box detector gives the full manifold of touching boxes;
+// separated boxes get GJK's closest point when a speculative margin is asked for; either way
+// the corners of a facing a face of b within the margin are added (addSpeculativeCorners).
+int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB, const btTransform& trB, uint32_t feature,
+                 uint32_t material, float speculativeMargin, LocalContact* out) {
+  btBoxShape a(bt(halfA)), b(bt(halfB));
+  btBoxBoxDetector det(&a, &b);
+  btDiscreteCollisionDetectorInterface::ClosestPointInput in;
+  in.m_transformA = trA;
+  in.m_transformB = trB;
+  BoxBoxCollector col;
+  col.out = out;
+  col.feature = feature;
+  col.material = material;
+  det.getClosestPoints(in, col, nullptr);
+  if (speculativeMargin <= 0.f) return col.count;
+  int n = col.count;
+  if (n == 0) {
+    // note: the detector reports touching boxes only; GJK measures the gap of separated ones
+    // (on the boxes' shapes with zero margins, so the gap is exact).
+    a.setMargin(0);
+    b.setMargin(0);
+    n = gjkEpa(a, trA, b, trB, feature, material, speculativeMargin, out);
+    if (n == 0) return 0;
+  }
+  return n < kMaxContactsPerBrick ? addSpeculativeCorners(halfA, trA, halfB, trB, speculativeMargin, out, n) : n;
+}
+
 }  // namespace
 
 int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
                       float speculativeMargin, LocalContact* out) {
   const btTransform trShape = poseTransform(pose);
   const btTransform trBrick = brickTransform(b);
-  if (shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box) {
-    btBoxShape a(bt(shape.halfExtents)), c(bt(b.halfSize));
-    btBoxBoxDetector det(&a, &c);
-    btDiscreteCollisionDetectorInterface::ClosestPointInput in;
-    in.m_transformA = trShape;
-    in.m_transformB = trBrick;
-    BoxBoxCollector col;
-    col.out = out;
-    col.feature = feature;
-    col.material = b.material;
-    det.getClosestPoints(in, col, nullptr);
-    // Touching boxes keep the detector's full manifold; separated ones fall through to GJK for
-    // a speculative point when a margin is asked for.
-    if (col.count > 0 && col.count < kMaxContactsPerBrick && speculativeMargin > 0.f)
-      return addSpeculativeCorners(shape, trShape, b, trBrick, speculativeMargin, out, col.count);
-    if (col.count > 0 || speculativeMargin <= 0.f) return col.count;
-  }
+  if (shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box)
+    return collideBoxes(shape.halfExtents, trShape, b.halfSize, trBrick, feature, b.material, speculativeMargin, out);
   BrickPointCloud cloud(b);
-  const int n = withBulletShape(shape, [&](btConvexShape& s) {
+  return withBulletShape(shape, [&](btConvexShape& s) {
     return gjkEpa(s, trShape, cloud.shape, trBrick, feature, b.material, speculativeMargin, out);
   });
-  if (n == 1 && out[0].depth < 0.f && shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box)
-    return addSpeculativeCorners(shape, trShape, b, trBrick, speculativeMargin, out, 1);
-  return n;
 }
 
 int reduceManifold(LocalContact* c, int n, int maxOut) {

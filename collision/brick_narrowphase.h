@@ -37,7 +37,8 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
                       float speculativeMargin, LocalContact* out);
 
 /// Contacts between two convex query shapes (both posed in one frame), GJK/EPA with zero
-/// margins; the normal points from b towards a, the point lies on b. Returns the count (0..1).
+/// margins; the normal points from b towards a, the point lies on b. Returns the count: 0..1,
+/// or up to kMaxContactsPerBrick for two boxes (a face manifold, as against box bricks).
 int collideShapes(const QueryShape& a, const LocalPose& poseA, const QueryShape& b, const LocalPose& poseB,
                   float speculativeMargin, LocalContact* out);
 

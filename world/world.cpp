@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cstring>
 #include <limits>
@@ -556,58 +557,135 @@ void World::buildIslands() {
   for (uint32_t k = 0; k < contacts_.size(); ++k) islandContacts_[fill[rootIndex[islandOfContact(contacts_[k])]]++] = k;
 }
 
+// Applies impulse `lambda` along direction d (0 normal, 1 and 2 tangents) to the contact's
+// dynamic bodies (static and kinematic bodies are read, never written).
+void World::applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda) {
+  if (bodies_.motion[s.a] == MotionType::Dynamic) {
+    bodies_.linearVelocity[s.a] += dir * (lambda * bodies_.inverseMass[s.a]);
+    bodies_.angularVelocity[s.a] += s.angA[d] * lambda;
+  }
+  if (bodies_.motion[s.b] == MotionType::Dynamic) {
+    bodies_.linearVelocity[s.b] -= dir * (lambda * bodies_.inverseMass[s.b]);
+    bodies_.angularVelocity[s.b] -= s.angB[d] * lambda;
+  }
+}
+
+void World::warmStart(const SolverContact& s) {
+  applyImpulse(s, 0, s.normal, s.lambdaN);
+  applyImpulse(s, 1, s.t1, s.lambdaT1);
+  applyImpulse(s, 2, s.t2, s.lambdaT2);
+}
+
+// One Gauss-Seidel update of one contact: normal impulse clamped at zero, then friction
+// clamped by the Coulomb bound.
+void World::solveContact(SolverContact& s) {
+  auto relative = [&] {
+    return Vec3f(bodies_.linearVelocity[s.a] + bodies_.angularVelocity[s.a].cross(s.rA) - bodies_.linearVelocity[s.b] -
+                 bodies_.angularVelocity[s.b].cross(s.rB));
+  };
+  const float oldN = s.lambdaN;
+  s.lambdaN = std::max(oldN + s.massN * (s.bias - relative().dot(s.normal)), 0.f);
+  applyImpulse(s, 0, s.normal, s.lambdaN - oldN);
+  const float limit = s.friction * s.lambdaN;
+  const Vec3f v = relative();
+  const float o1 = s.lambdaT1, o2 = s.lambdaT2;
+  s.lambdaT1 = std::clamp(o1 - s.massT1 * v.dot(s.t1), -limit, limit);
+  s.lambdaT2 = std::clamp(o2 - s.massT2 * v.dot(s.t2), -limit, limit);
+  applyImpulse(s, 1, s.t1, s.lambdaT1 - o1);
+  applyImpulse(s, 2, s.t2, s.lambdaT2 - o2);
+}
+
 void World::solveIsland(uint32_t island) {
   const uint32_t begin = islandStart_[island], end = islandStart_[island + 1];
-  auto apply = [&](const SolverContact& s, int d, const Vec3f& dir, float lambda) {
-    if (bodies_.motion[s.a] == MotionType::Dynamic) {
-      bodies_.linearVelocity[s.a] += dir * (lambda * bodies_.inverseMass[s.a]);
-      bodies_.angularVelocity[s.a] += s.angA[d] * lambda;
-    }
-    if (bodies_.motion[s.b] == MotionType::Dynamic) {
-      bodies_.linearVelocity[s.b] -= dir * (lambda * bodies_.inverseMass[s.b]);
-      bodies_.angularVelocity[s.b] -= s.angB[d] * lambda;
-    }
-  };
-  // Warm start, then iterate.
-  for (uint32_t k = begin; k < end; ++k) {
-    const SolverContact& s = contacts_[islandContacts_[k]];
-    apply(s, 0, s.normal, s.lambdaN);
-    apply(s, 1, s.t1, s.lambdaT1);
-    apply(s, 2, s.t2, s.lambdaT2);
-  }
+  for (uint32_t k = begin; k < end; ++k) warmStart(contacts_[islandContacts_[k]]);
   for (int it = 0; it < scene_.settings.solverIterations; ++it) {
     // note: sweeps alternate direction (symmetric Gauss-Seidel) so no contact is always solved
     // last; a fixed order makes friction in stacks creep one way.
     for (uint32_t j = begin; j < end; ++j) {
       const uint32_t k = (it & 1) ? end - 1 - (j - begin) : j;
-      SolverContact& s = contacts_[islandContacts_[k]];
-      auto relative = [&] {
-        return Vec3f(bodies_.linearVelocity[s.a] + bodies_.angularVelocity[s.a].cross(s.rA) - bodies_.linearVelocity[s.b] -
-                     bodies_.angularVelocity[s.b].cross(s.rB));
-      };
-      // Normal: accumulated impulse clamped at zero.
-      const float oldN = s.lambdaN;
-      s.lambdaN = std::max(oldN + s.massN * (s.bias - relative().dot(s.normal)), 0.f);
-      apply(s, 0, s.normal, s.lambdaN - oldN);
-      // Friction: each tangent clamped by the Coulomb bound.
-      const float limit = s.friction * s.lambdaN;
-      const Vec3f v = relative();
-      const float o1 = s.lambdaT1, o2 = s.lambdaT2;
-      s.lambdaT1 = std::clamp(o1 - s.massT1 * v.dot(s.t1), -limit, limit);
-      s.lambdaT2 = std::clamp(o2 - s.massT2 * v.dot(s.t2), -limit, limit);
-      apply(s, 1, s.t1, s.lambdaT1 - o1);
-      apply(s, 2, s.t2, s.lambdaT2 - o2);
+      solveContact(contacts_[islandContacts_[k]]);
+    }
+  }
+}
+
+// A large island's contacts in colours: no two contacts of a colour share a dynamic body, so a
+// colour's contacts can be solved at once on every thread. Greedy in island order (the lowest
+// colour free for both bodies), so the colouring is a pure function of the contact list; a
+// contact for which all kMaxColours are taken goes to a last, serial group.
+void World::colourIsland(uint32_t island) {
+  const uint32_t begin = islandStart_[island], end = islandStart_[island + 1];
+  colourOf_.resize(end - begin);
+  uint32_t used = 0;
+  for (uint32_t j = begin; j < end; ++j) {
+    const SolverContact& s = contacts_[islandContacts_[j]];
+    uint64_t taken = 0;
+    for (uint32_t x : {s.a, s.b})
+      if (bodies_.motion[x] == MotionType::Dynamic) taken |= bodyColours_[x];
+    const uint32_t colour = taken == ~uint64_t(0) ? kMaxColours : uint32_t(std::countr_one(taken));
+    if (colour < kMaxColours)
+      for (uint32_t x : {s.a, s.b})
+        if (bodies_.motion[x] == MotionType::Dynamic) bodyColours_[x] |= uint64_t(1) << colour;
+    colourOf_[j - begin] = colour;
+    used = std::max(used, colour + 1);
+  }
+  // Counting sort into colour groups, island order kept within a group.
+  colourStart_.assign(used + 1, 0);
+  for (uint32_t c : colourOf_) ++colourStart_[c + 1];
+  for (uint32_t c = 0; c < used; ++c) colourStart_[c + 1] += colourStart_[c];
+  colourContacts_.resize(end - begin);
+  std::vector<uint32_t>& fill = colourFill_;
+  fill.assign(colourStart_.begin(), colourStart_.end() - 1);
+  for (uint32_t j = begin; j < end; ++j) colourContacts_[fill[colourOf_[j - begin]]++] = islandContacts_[j];
+  for (uint32_t j = begin; j < end; ++j) {
+    const SolverContact& s = contacts_[islandContacts_[j]];
+    bodyColours_[s.a] = bodyColours_[s.b] = 0;  // clean for the next island
+  }
+}
+
+// One big island (a pile) on every thread: colour by colour, each colour's contacts in parallel.
+// Iterations alternate the colour order like solveIsland alternates the contact order.
+void World::solveIslandInColours(uint32_t island) {
+  colourIsland(island);
+  const uint32_t colours = uint32_t(colourStart_.size() - 1);
+  for (uint32_t c : colourContacts_) warmStart(contacts_[c]);
+  for (int it = 0; it < scene_.settings.solverIterations; ++it) {
+    for (uint32_t i = 0; i < colours; ++i) {
+      const uint32_t c = (it & 1) ? colours - 1 - i : i;
+      const uint32_t b = colourStart_[c], e = colourStart_[c + 1];
+      if (c == kMaxColours) {  // the serial group: contacts may share bodies
+        for (uint32_t j = b; j < e; ++j) solveContact(contacts_[colourContacts_[j]]);
+        continue;
+      }
+      jobs_.parallelFor(b, e, kColourGrain, [&](uint32_t cb, uint32_t ce) {
+        ProfileZone zone(profiler_, "colour", stage_ + 3);
+        for (uint32_t j = cb; j < ce; ++j) solveContact(contacts_[colourContacts_[j]]);
+      });
     }
   }
 }
 
 void World::solve() {
   // Islands touch disjoint dynamic bodies: solving them in parallel is race-free and gives the
-  // same result as solving them one by one.
+  // same result as solving them one by one. Islands above kSplitContacts are split by colour
+  // instead (first, one at a time, each on every thread); which islands are split depends only
+  // on their size, so the result does not depend on the thread count.
   const uint32_t islands = uint32_t(islandStart_.size() - 1);
-  jobs_.parallelFor(0, islands, 1, [&](uint32_t b, uint32_t e) {
+  smallIslands_.clear();
+  bodyColours_.assign(bodies_.size(), 0);
+  stats_.largestIsland = 0;
+  for (uint32_t i = 0; i < islands; ++i) {
+    const uint32_t size = islandStart_[i + 1] - islandStart_[i];
+    stats_.largestIsland = std::max(stats_.largestIsland, size);
+    if (size > kSplitContacts) {
+      solveIslandInColours(i);
+      ++stats_.splitIslands;
+    } else {
+      smallIslands_.push_back(i);
+    }
+  }
+  jobs_.parallelFor(0, uint32_t(smallIslands_.size()), 1, [&](uint32_t b, uint32_t e) {
     ProfileZone zone(profiler_, "island", stage_ + 3);
-    for (uint32_t i = b; i < e; ++i) solveIsland(i);
+    for (uint32_t i = b; i < e; ++i) solveIsland(smallIslands_[i]);
   });
   nextCache_.clear();
   for (const SolverContact& s : contacts_) nextCache_.push_back({s.key, s.point, s.lambdaN, s.lambdaT1, s.lambdaT2});

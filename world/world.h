@@ -12,8 +12,9 @@
 /// (convex approximation) and primitive-vs-primitive contacts with speculative margins, a
 /// sequential-impulse solver with friction, restitution and warm starting matched by contact
 /// feature, islands (union-find over contacts) solved in parallel, sleeping islands, and
-/// semi-implicit Euler integration with substeps. Not yet: splitting one huge island across
-/// threads. Terrains (MagicaVoxel models) are static bodies whose pairs run on one thread (their
+/// semi-implicit Euler integration with substeps. Islands above kSplitContacts contacts are
+/// coloured (no two contacts of a colour share a dynamic body) and solved colour by colour on
+/// every thread, so one big pile still uses them all. Terrains (MagicaVoxel models) are static bodies whose pairs run on one thread (their
 /// chunk cache is filled by queries); water voxels float bodies (buoyancy and drag).
 #include <cstdint>
 #include <memory>
@@ -42,6 +43,8 @@ struct StepStats {
   uint64_t rayBoxTests = 0;
   uint32_t terrainContacts = 0;  ///< contacts against terrains (included in contacts)
   uint32_t floating = 0;         ///< awake bodies touching water (last substep)
+  uint32_t largestIsland = 0;    ///< contacts in the largest island (last substep)
+  uint32_t splitIslands = 0;     ///< islands solved colour by colour on every thread
 };
 
 class World {
@@ -128,6 +131,15 @@ class World {
   void prepareSolver(float dt);
   void solve();
   void solveIsland(uint32_t island);
+  void solveIslandInColours(uint32_t island);
+  void colourIsland(uint32_t island);
+  void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
+  void warmStart(const SolverContact& s);
+  void solveContact(SolverContact& s);
+  // Islands with more contacts than this are solved colour by colour on every thread.
+  static constexpr uint32_t kSplitContacts = 512;
+  static constexpr uint32_t kMaxColours = 64;
+  static constexpr uint32_t kColourGrain = 64;
   void buildIslands();
   void updateSleep(float dt);
   bool active(uint32_t body) const {
@@ -159,6 +171,9 @@ class World {
   std::vector<uint32_t> islandOf_;                  // union-find parent per body
   std::vector<uint32_t> islandStart_, islandContacts_;  // contacts grouped by island (CSR)
   std::vector<uint32_t> islandBodiesStart_, islandBodies_;
+  std::vector<uint32_t> smallIslands_;              // islands solved whole, in parallel
+  std::vector<uint64_t> bodyColours_;               // per body: colours taken (while colouring)
+  std::vector<uint32_t> colourOf_, colourStart_, colourContacts_, colourFill_;  // one split island
   std::vector<float> stillTime_;                    // seconds each body has been nearly still
   std::vector<uint8_t> asleep_;
   std::vector<CachedImpulse> cache_, nextCache_;

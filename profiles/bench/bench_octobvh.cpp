@@ -4,6 +4,9 @@
 //
 // Load/<Index>/<n>: the article's load workload: insert each brick, then query a box around it
 // (as a game does to hide adjacent faces); counters box_tests, ns_per_brick, bytes_per_element.
+// LoadLighthouse/<Index> and LoadLighthouseTiled/<Index>: the same workload on the real save
+// ../shared/data/Lighthouse_Island.brs (25,427 bricks) and on it tiled 10 x 10 (2,542,700 bricks,
+// the article's build size), bricks in file order, tile by tile.
 // Edit/<Index>: insert, remove and update at 1M (ns per op). Overlap2m/<Index>, RayClosest200m/
 // <Index>, LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs
 // reversed child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again.
@@ -14,11 +17,16 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 
+#include "collision/brick_geometry.h"
 #include "collision/brick_workload.h"
+#include "collision/brs_reader.h"
+#include "collision/build_tiling.h"
 #include "collision/loose_octree.h"
 #include "collision/octobvh.h"
 #include "collision/seeded_random.h"
@@ -50,6 +58,50 @@ const std::vector<Aabb>& build(uint32_t n) {
 
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// ---------------------------------------------------------------- real builds
+
+// The shared data folder sits next to the repository (<repo>/../shared/data), as for the CLI and
+// the tests; a run from another checkout can also find it relative to the working directory.
+std::filesystem::path lighthousePath() {
+  namespace fs = std::filesystem;
+  const fs::path fromSource = fs::path(BW_SOURCE_DIR) / ".." / "shared" / "data" / "Lighthouse_Island.brs";
+  if (fs::exists(fromSource)) return fromSource;
+  const fs::path fromCwd = fs::current_path() / ".." / "shared" / "data" / "Lighthouse_Island.brs";
+  if (fs::exists(fromCwd)) return fromCwd;
+  return fromSource;
+}
+
+constexpr size_t kTiledTarget = 2'500'000;  // the article's Brick Party is ~2M bricks
+constexpr float kTileGap = 4.f;             // 10 studs between islands
+
+// Bounds of the bricks of Lighthouse_Island (tiles = 1) or of its tiling to ~kTiledTarget bricks,
+// in load order. Empty with `error` set when the save is missing or unreadable.
+const std::vector<Aabb>& lighthouseBuild(bool tiled, std::string& error) {
+  static std::map<bool, std::vector<Aabb>> cache;
+  static std::string loadError;
+  auto it = cache.find(tiled);
+  if (it == cache.end()) {
+    std::vector<Aabb> out;
+    const std::filesystem::path path = lighthousePath();
+    if (!std::filesystem::exists(path)) {
+      loadError = "missing " + path.string() + ": the shared data folder (../shared/data) must sit next to the repository";
+    } else {
+      try {
+        const bw::BrsLoadResult save = bw::loadBrs(path.string());
+        const int n = tiled ? bw::tilesForTarget(save.bricks.size(), kTiledTarget) : 1;
+        const std::vector<bw::Brick> bricks = bw::tileBuild(save.bricks, save.bounds, n, n, kTileGap);
+        out.reserve(bricks.size());
+        for (const bw::Brick& b : bricks) out.push_back(bw::brickBounds(b));
+      } catch (const std::exception& e) {
+        loadError = e.what();
+      }
+    }
+    it = cache.emplace(tiled, std::move(out)).first;
+  }
+  error = it->second.empty() ? loadError : std::string();
+  return it->second;
+}
+
 // The box a game queries after placing a brick: the brick grown by a small margin.
 Aabb around(const Aabb& b) { return b.expanded(0.05f); }
 
@@ -63,6 +115,28 @@ struct CountHits : btDbvt::ICollide {
   uint64_t hits = 0;
   void Process(const btDbvtNode*) override { ++hits; }
 };
+
+// btDbvt::collideTV's walk (pop a node, test its volume, descend or report) with the volume
+// tests counted, so btDbvt's box tests compare with QueryStats::boxTests. Returns the hits.
+uint64_t dbvtOverlap(const btDbvt& tree, const btDbvtVolume& vol, std::vector<const btDbvtNode*>& stack, uint64_t& tests) {
+  uint64_t hits = 0;
+  if (!tree.m_root) return 0;
+  stack.clear();
+  stack.push_back(tree.m_root);
+  while (!stack.empty()) {
+    const btDbvtNode* n = stack.back();
+    stack.pop_back();
+    ++tests;
+    if (!Intersect(n->volume, vol)) continue;
+    if (n->isinternal()) {
+      stack.push_back(n->childs[0]);
+      stack.push_back(n->childs[1]);
+    } else {
+      ++hits;
+    }
+  }
+  return hits;
+}
 
 struct ClosestRay : btDbvt::ICollide {
   btVector3 from, dir;
@@ -87,10 +161,10 @@ struct ClosestRay : btDbvt::ICollide {
 
 // ---------------------------------------------------------------- load workload
 
+// One run of the load workload over `bricks` (in order); `key` names the build in the summary.
 template <class Index>
-void loadWith(benchmark::State& state, const char* name) {
-  const uint32_t n = uint32_t(state.range(0));
-  const std::vector<Aabb>& bricks = build(n);
+void loadIndex(benchmark::State& state, std::span<const Aabb> bricks, const char* name, const std::string& key) {
+  const uint32_t n = uint32_t(bricks.size());
   for (auto _ : state) {
     Index index(typename Index::Config{n + 1024});
     bw::QueryStats st;
@@ -101,6 +175,7 @@ void loadWith(benchmark::State& state, const char* name) {
       index.overlap(around(bricks[i]), 1, [&](uint32_t) { ++found; }, &st);
     }
     const double s = secondsSince(t);
+    state.counters["bricks"] = double(n);
     state.counters["box_tests"] = double(st.boxTests);
     state.counters["box_tests_per_brick"] = double(st.boxTests) / n;
     state.counters["ns_per_brick"] = s * 1e9 / n;
@@ -112,33 +187,72 @@ void loadWith(benchmark::State& state, const char* name) {
     } else {
       state.counters["bytes_per_element"] = double(index.nodeBytes() + index.elementBytes()) / n;
     }
-    summary()[std::string("load_tests_") + name + "_" + std::to_string(n)] = double(st.boxTests);
-    summary()[std::string("load_s_") + name + "_" + std::to_string(n)] = s;
+    summary()[std::string("load_tests_") + name + "_" + key] = double(st.boxTests);
+    summary()[std::string("load_s_") + name + "_" + key] = s;
+    summary()["load_n_" + key] = double(n);
   }
+}
+
+void loadDbvt(benchmark::State& state, std::span<const Aabb> bricks, const std::string& key) {
+  const uint32_t n = uint32_t(bricks.size());
+  for (auto _ : state) {
+    btDbvt tree;
+    std::vector<const btDbvtNode*> stack;
+    uint64_t hits = 0, tests = 0;
+    const auto t = Clock::now();
+    for (uint32_t i = 0; i < n; ++i) {
+      tree.insert(volume(bricks[i]), nullptr);
+      hits += dbvtOverlap(tree, volume(around(bricks[i])), stack, tests);
+    }
+    const double s = secondsSince(t);
+    state.counters["bricks"] = double(n);
+    state.counters["box_tests"] = double(tests);
+    state.counters["box_tests_per_brick"] = double(tests) / n;
+    state.counters["ns_per_brick"] = s * 1e9 / n;
+    state.counters["hits_per_query"] = double(hits) / n;
+    // btDbvt keeps 2n-1 nodes (leaves + internal), each a btDbvtNode.
+    state.counters["bytes_per_element"] = double(sizeof(btDbvtNode)) * (2.0 * n - 1) / n;
+    summary()["load_tests_btDbvt_" + key] = double(tests);
+    summary()["load_s_btDbvt_" + key] = s;
+    summary()["load_n_" + key] = double(n);
+  }
+}
+
+template <class Index>
+void loadWith(benchmark::State& state, const char* name) {
+  const uint32_t n = uint32_t(state.range(0));
+  loadIndex<Index>(state, build(n), name, std::to_string(n));
 }
 
 void Load_OctoBVH(benchmark::State& state) { loadWith<bw::OctoBvh>(state, "OctoBVH"); }
 void Load_LooseOctree(benchmark::State& state) { loadWith<bw::LooseOctree>(state, "LooseOctree"); }
-
 void Load_btDbvt(benchmark::State& state) {
   const uint32_t n = uint32_t(state.range(0));
-  const std::vector<Aabb>& bricks = build(n);
-  for (auto _ : state) {
-    btDbvt tree;
-    CountHits hits;
-    const auto t = Clock::now();
-    for (uint32_t i = 0; i < n; ++i) {
-      tree.insert(volume(bricks[i]), nullptr);
-      tree.collideTV(tree.m_root, volume(around(bricks[i])), hits);
-    }
-    const double s = secondsSince(t);
-    state.counters["ns_per_brick"] = s * 1e9 / n;
-    state.counters["hits_per_query"] = double(hits.hits) / n;
-    // btDbvt keeps 2n-1 nodes (leaves + internal), each a btDbvtNode.
-    state.counters["bytes_per_element"] = double(sizeof(btDbvtNode)) * (2.0 * n - 1) / n;
-    summary()["load_s_btDbvt_" + std::to_string(n)] = s;
+  loadDbvt(state, build(n), std::to_string(n));
+}
+
+// The same workload on the real save, untiled ("lighthouse") or tiled ("lighthouse_tiled").
+template <class Index>
+void loadLighthouse(benchmark::State& state, const char* name, bool tiled) {
+  std::string error;
+  const std::vector<Aabb>& bricks = lighthouseBuild(tiled, error);
+  if (!error.empty()) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const std::string key = tiled ? "lighthouse_tiled" : "lighthouse";
+  if constexpr (std::is_same_v<Index, btDbvt>) {
+    loadDbvt(state, bricks, key);
+  } else {
+    loadIndex<Index>(state, bricks, name, key);
   }
 }
+void LoadLighthouse_OctoBVH(benchmark::State& s) { loadLighthouse<bw::OctoBvh>(s, "OctoBVH", false); }
+void LoadLighthouse_LooseOctree(benchmark::State& s) { loadLighthouse<bw::LooseOctree>(s, "LooseOctree", false); }
+void LoadLighthouse_btDbvt(benchmark::State& s) { loadLighthouse<btDbvt>(s, "btDbvt", false); }
+void LoadLighthouseTiled_OctoBVH(benchmark::State& s) { loadLighthouse<bw::OctoBvh>(s, "OctoBVH", true); }
+void LoadLighthouseTiled_LooseOctree(benchmark::State& s) { loadLighthouse<bw::LooseOctree>(s, "LooseOctree", true); }
+void LoadLighthouseTiled_btDbvt(benchmark::State& s) { loadLighthouse<btDbvt>(s, "btDbvt", true); }
 
 // ---------------------------------------------------------------- 1M prebuilt indices
 
@@ -391,13 +505,18 @@ void printSummary() {
   auto& s = summary();
   auto get = [&](const std::string& k) { return s.count(k) ? s[k] : 0.0; };
   std::printf("\n== Comparisons (same run)\n");
-  for (uint32_t n : {100'000u, 1'000'000u, 4'000'000u}) {
-    const std::string sn = std::to_string(n);
-    if (!get("load_tests_OctoBVH_" + sn) || !get("load_tests_LooseOctree_" + sn)) continue;
-    std::printf("load %8u bricks: box tests LooseOctree/OctoBVH = %.2fx (%.3g vs %.3g), time LooseOctree/OctoBVH = %.2fx",
-                n, get("load_tests_LooseOctree_" + sn) / get("load_tests_OctoBVH_" + sn), get("load_tests_LooseOctree_" + sn),
-                get("load_tests_OctoBVH_" + sn), get("load_s_LooseOctree_" + sn) / get("load_s_OctoBVH_" + sn));
-    if (get("load_s_btDbvt_" + sn)) std::printf(", btDbvt/OctoBVH = %.2fx", get("load_s_btDbvt_" + sn) / get("load_s_OctoBVH_" + sn));
+  for (const std::string key : {"100000", "1000000", "4000000", "lighthouse", "lighthouse_tiled"}) {
+    if (!get("load_tests_OctoBVH_" + key) || !get("load_tests_LooseOctree_" + key)) continue;
+    const double octo = get("load_tests_OctoBVH_" + key), loose = get("load_tests_LooseOctree_" + key);
+    std::printf("load %-16s %8.0f bricks: box tests LooseOctree/OctoBVH = %.2fx (%.3g vs %.3g), time LooseOctree/OctoBVH = %.2fx "
+                "(%.2f s vs %.2f s)",
+                key.c_str(), get("load_n_" + key), loose / octo, loose, octo,
+                get("load_s_LooseOctree_" + key) / get("load_s_OctoBVH_" + key), get("load_s_LooseOctree_" + key),
+                get("load_s_OctoBVH_" + key));
+    if (get("load_s_btDbvt_" + key))
+      std::printf(", btDbvt/OctoBVH box tests = %.2fx (%.3g), time = %.2fx (%.2f s)", get("load_tests_btDbvt_" + key) / octo,
+                  get("load_tests_btDbvt_" + key), get("load_s_btDbvt_" + key) / get("load_s_OctoBVH_" + key),
+                  get("load_s_btDbvt_" + key));
     std::printf("\n");
   }
   if (get("order_tests_front"))
@@ -422,6 +541,12 @@ BENCHMARK(Load_OctoBVH)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iteration
 BENCHMARK(Load_LooseOctree)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 // btDbvt stops at 1M: its incremental load is superlinear here (1M took 48 s, 4M did not finish in 5 min).
 BENCHMARK(Load_btDbvt)->Arg(100'000)->Arg(1'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouse_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouse_LooseOctree)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouse_btDbvt)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouseTiled_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouseTiled_LooseOctree)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouseTiled_btDbvt)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_OctoBVH)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_LooseOctree)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_btDbvt)->Iterations(3)->Unit(benchmark::kMillisecond);

@@ -101,7 +101,7 @@ int runScene(const SceneRunOptions& o) {
 
   Series total, broad, contacts, solver, integrate, rays;
   uint64_t pairs = 0, contactCount = 0, boxTests = 0, reused = 0, rayCount = 0, rayHits = 0, rayBoxTests = 0, terrainContacts = 0;
-  uint32_t floating = 0;
+  uint32_t floating = 0, largestIsland = 0, splitIslands = 0;
   std::ofstream csv;
   if (!o.csvPath.empty()) {
     csv.open(o.csvPath);
@@ -124,6 +124,8 @@ int runScene(const SceneRunOptions& o) {
     rayBoxTests += s.rayBoxTests;
     terrainContacts += s.terrainContacts;
     floating = s.floating;
+    largestIsland = std::max(largestIsland, s.largestIsland);
+    splitIslands += s.splitIslands;
     pairs += s.pairs;
     contactCount += s.contacts;
     boxTests += s.boxTests;
@@ -171,6 +173,8 @@ int runScene(const SceneRunOptions& o) {
                      {"pairs_reused_per_frame", double(reused) / frames},
                      {"contacts_per_frame", double(contactCount) / frames},
                      {"box_tests_per_frame", double(boxTests) / frames},
+                     {"largest_island_contacts", largestIsland},
+                     {"split_islands_per_frame", double(splitIslands) / frames},
                      {"peak_resident_mib", peakResidentMiB()},
                      {"dynamic_resting", resting},
                      {"dynamic_asleep", world.sleepingCount()},
@@ -207,6 +211,8 @@ int runScene(const SceneRunOptions& o) {
   }
   std::printf("  per frame: %.0f pairs (%.0f reused from the pair cache), %.0f contacts, %.0f box tests\n", double(pairs) / frames,
               double(reused) / frames, double(contactCount) / frames, double(boxTests) / frames);
+  std::printf("  islands: largest %u contacts; %.1f per frame split by colour over the threads\n", largestIsland,
+              double(splitIslands) / frames);
   if (rayCount)
     std::printf("  rays: %.0f per frame, %.1f%% hit, %.0f box tests per ray\n", double(rayCount) / frames,
                 100.0 * double(rayHits) / double(rayCount), double(rayBoxTests) / double(rayCount));
