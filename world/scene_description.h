@@ -69,7 +69,7 @@ struct TerrainDescription {
   std::string name;
   std::string file;                ///< .vox path (resolved against the scene file)
   float voxelSize = 1.f;           ///< edge of one voxel in world units
-  Vec3d position = Vec3d::Zero();  ///< world position of the terrain's voxel (0, 0, 0) corner
+  Vec3d position = Vec3d::Zero();  ///< world position of the model's voxel (0, 0, 0) corner
   int waterFirst = -1, waterLast = -1;  ///< palette index range that is water (-1: none)
   float waterDensity = 1000.f;     ///< kg/m^3, for buoyancy
 };
@@ -87,6 +87,7 @@ struct SceneSettings {
   double timestep = 1.0 / 60.0;  ///< seconds per frame
   int substeps = 1;
   int solverIterations = 8;
+  int relaxIterations = 2;           ///< velocity iterations after integration without push-out
   uint32_t frames = 300;
   float lodFraction = 1.f / 16;
   int approximationDepth = 3;

@@ -56,6 +56,7 @@ void validateScene(const SceneDescription& scene) {
   c.number("settings.solver_iterations", s.solverIterations, 1, 256);
   c.number("settings.lod_fraction", s.lodFraction, 0, 1);
   c.number("settings.approximation_depth", s.approximationDepth, 0, 7);
+  c.number("settings.relax_iterations", s.relaxIterations, 0, 64);
   c.number("settings.manifold_size", s.manifoldSize, 1, 64);
   c.number("settings.reuse_translation", s.reuseTranslation, 0, 1);
   c.number("settings.reuse_rotation", s.reuseRotation, 0, 1);

@@ -154,6 +154,10 @@ void World::buildTerrain(const TerrainDescription& t) {
   } catch (const InvalidInput& e) {
     throw SceneError(scene_.source + ": terrain '" + t.name + "': " + e.what());
   }
+  // The scene places the model's voxel (0, 0, 0) corner; the terrain adds a margin of air
+  // around the model, so its own origin sits that margin lower.
+  const Vec3d margin(built.voxToTerrain.x, built.voxToTerrain.y, built.voxToTerrain.z);
+  built.terrain->setPlacement(RigidTransform{t.position - margin * double(t.voxelSize), Quatf::Identity()});
   BodyShape shape;
   shape.terrain = uint32_t(terrains_.size());
   terrains_.push_back(std::move(built.terrain));
@@ -488,9 +492,11 @@ void World::prepareSolver(float dt) {
       const float vn = vRel.dot(n);
       // Penetrating: push out (Baumgarte) and restitute fast impacts. Speculative (a gap of -depth):
       // the bodies may approach by at most the gap this step.
-      s.bias = s.depth >= 0.f ? std::min(kBaumgarte / dt * std::max(s.depth - kSlop, 0.f), kMaxPushOut) +
-                                    (vn < -kBounceThreshold ? -kRestitution * vn : 0.f)
-                              : s.depth / dt;
+      const float bounce = vn < -kBounceThreshold ? -kRestitution * vn : 0.f;
+      s.bias = s.depth >= 0.f ? std::min(kBaumgarte / dt * std::max(s.depth - kSlop, 0.f), kMaxPushOut) + bounce : s.depth / dt;
+      // The relax pass after integration keeps restitution and speculative gaps but drops the
+      // push-out, so no push-out velocity survives into the next step (resting stacks stay put).
+      s.relaxBias = s.depth >= 0.f ? bounce : s.depth / dt;
       // Warm start from the nearest cached impulse of the same pair and feature.
       auto range = std::equal_range(cache_.begin(), cache_.end(), CachedImpulse{s.key, {}, 0, 0, 0},
                                     [](const CachedImpulse& x, const CachedImpulse& y) { return x.key < y.key; });
@@ -578,13 +584,13 @@ void World::warmStart(const SolverContact& s) {
 
 // One Gauss-Seidel update of one contact: normal impulse clamped at zero, then friction
 // clamped by the Coulomb bound.
-void World::solveContact(SolverContact& s) {
+void World::solveContact(SolverContact& s, bool relax) {
   auto relative = [&] {
     return Vec3f(bodies_.linearVelocity[s.a] + bodies_.angularVelocity[s.a].cross(s.rA) - bodies_.linearVelocity[s.b] -
                  bodies_.angularVelocity[s.b].cross(s.rB));
   };
   const float oldN = s.lambdaN;
-  s.lambdaN = std::max(oldN + s.massN * (s.bias - relative().dot(s.normal)), 0.f);
+  s.lambdaN = std::max(oldN + s.massN * ((relax ? s.relaxBias : s.bias) - relative().dot(s.normal)), 0.f);
   applyImpulse(s, 0, s.normal, s.lambdaN - oldN);
   const float limit = s.friction * s.lambdaN;
   const Vec3f v = relative();
@@ -595,15 +601,17 @@ void World::solveContact(SolverContact& s) {
   applyImpulse(s, 2, s.t2, s.lambdaT2 - o2);
 }
 
-void World::solveIsland(uint32_t island) {
+void World::solveIsland(uint32_t island, bool relax) {
   const uint32_t begin = islandStart_[island], end = islandStart_[island + 1];
-  for (uint32_t k = begin; k < end; ++k) warmStart(contacts_[islandContacts_[k]]);
-  for (int it = 0; it < scene_.settings.solverIterations; ++it) {
+  if (!relax)
+    for (uint32_t k = begin; k < end; ++k) warmStart(contacts_[islandContacts_[k]]);
+  const int iterations = relax ? scene_.settings.relaxIterations : scene_.settings.solverIterations;
+  for (int it = 0; it < iterations; ++it) {
     // note: sweeps alternate direction (symmetric Gauss-Seidel) so no contact is always solved
     // last; a fixed order makes friction in stacks creep one way.
     for (uint32_t j = begin; j < end; ++j) {
       const uint32_t k = (it & 1) ? end - 1 - (j - begin) : j;
-      solveContact(contacts_[islandContacts_[k]]);
+      solveContact(contacts_[islandContacts_[k]], relax);
     }
   }
 }
@@ -644,27 +652,29 @@ void World::colourIsland(uint32_t island) {
 
 // One big island (a pile) on every thread: colour by colour, each colour's contacts in parallel.
 // Iterations alternate the colour order like solveIsland alternates the contact order.
-void World::solveIslandInColours(uint32_t island) {
+void World::solveIslandInColours(uint32_t island, bool relax) {
   colourIsland(island);
   const uint32_t colours = uint32_t(colourStart_.size() - 1);
-  for (uint32_t c : colourContacts_) warmStart(contacts_[c]);
-  for (int it = 0; it < scene_.settings.solverIterations; ++it) {
+  if (!relax)
+    for (uint32_t c : colourContacts_) warmStart(contacts_[c]);
+  const int iterations = relax ? scene_.settings.relaxIterations : scene_.settings.solverIterations;
+  for (int it = 0; it < iterations; ++it) {
     for (uint32_t i = 0; i < colours; ++i) {
       const uint32_t c = (it & 1) ? colours - 1 - i : i;
       const uint32_t b = colourStart_[c], e = colourStart_[c + 1];
       if (c == kMaxColours) {  // the serial group: contacts may share bodies
-        for (uint32_t j = b; j < e; ++j) solveContact(contacts_[colourContacts_[j]]);
+        for (uint32_t j = b; j < e; ++j) solveContact(contacts_[colourContacts_[j]], relax);
         continue;
       }
       jobs_.parallelFor(b, e, kColourGrain, [&](uint32_t cb, uint32_t ce) {
-        ProfileZone zone(profiler_, "colour", stage_ + 3);
-        for (uint32_t j = cb; j < ce; ++j) solveContact(contacts_[colourContacts_[j]]);
+        ProfileZone zone(profiler_, "colour", stage_ + (relax ? 5 : 3));
+        for (uint32_t j = cb; j < ce; ++j) solveContact(contacts_[colourContacts_[j]], relax);
       });
     }
   }
 }
 
-void World::solve() {
+void World::solve(bool relax) {
   // Islands touch disjoint dynamic bodies: solving them in parallel is race-free and gives the
   // same result as solving them one by one. Islands above kSplitContacts are split by colour
   // instead (first, one at a time, each on every thread); which islands are split depends only
@@ -672,21 +682,23 @@ void World::solve() {
   const uint32_t islands = uint32_t(islandStart_.size() - 1);
   smallIslands_.clear();
   bodyColours_.assign(bodies_.size(), 0);
-  stats_.largestIsland = 0;
+  if (!relax) stats_.largestIsland = 0;
   for (uint32_t i = 0; i < islands; ++i) {
     const uint32_t size = islandStart_[i + 1] - islandStart_[i];
-    stats_.largestIsland = std::max(stats_.largestIsland, size);
+    if (!relax) stats_.largestIsland = std::max(stats_.largestIsland, size);
     if (size > kSplitContacts) {
-      solveIslandInColours(i);
-      ++stats_.splitIslands;
+      solveIslandInColours(i, relax);
+      if (!relax) ++stats_.splitIslands;
     } else {
       smallIslands_.push_back(i);
     }
   }
   jobs_.parallelFor(0, uint32_t(smallIslands_.size()), 1, [&](uint32_t b, uint32_t e) {
-    ProfileZone zone(profiler_, "island", stage_ + 3);
-    for (uint32_t i = b; i < e; ++i) solveIsland(smallIslands_[i]);
+    ProfileZone zone(profiler_, relax ? "relax" : "island", stage_ + (relax ? 5 : 3));
+    for (uint32_t i = b; i < e; ++i) solveIsland(smallIslands_[i], relax);
   });
+  if (!relax) return;
+  // The final impulses warm-start the next substep.
   nextCache_.clear();
   for (const SolverContact& s : contacts_) nextCache_.push_back({s.key, s.point, s.lambdaN, s.lambdaT1, s.lambdaT2});
   std::stable_sort(nextCache_.begin(), nextCache_.end(), [](const CachedImpulse& x, const CachedImpulse& y) { return x.key < y.key; });
@@ -732,7 +744,7 @@ void World::integrate(float dt) {
 void World::substep(float dt, int index) {
   // Stages of successive substeps run one after another: distinct stage ids for work/span.
   // Serial stages record one zone; parallel stages one zone per chunk (the jobs).
-  const int stage = index * 5;
+  const int stage = index * kStagesPerSubstep;
   stage_ = stage;
   // Gravity on dynamic bodies first (semi-implicit Euler).
   const Vec3f g = scene_.settings.gravity.cast<float>();
@@ -761,16 +773,24 @@ void World::substep(float dt, int index) {
       buildIslands();
     }
     ProfileZone z(profiler_, "solve (stage)");
-    solve();
+    solve(false);
   }
   stats_.solverMs += msSince(t);
   t = Clock::now();
   {
     ProfileZone z(profiler_, "integrate", stage + 4);
     integrate(dt);
-    updateSleep(dt);
   }
   stats_.integrateMs += msSince(t);
+  t = Clock::now();
+  {
+    // Positions moved with the push-out; relaxing the velocities now removes it from what the
+    // bodies carry into the next substep.
+    ProfileZone z(profiler_, "relax (stage)");
+    solve(true);
+  }
+  stats_.solverMs += msSince(t);
+  updateSleep(dt);
   stats_.pairs += uint32_t(pairs_.size());
   stats_.contacts += uint32_t(contacts_.size());
   for (const ContactStats& s : pairStats_) {
@@ -802,7 +822,7 @@ void World::fireRays() {
   rayHitT_.assign(load.count, std::numeric_limits<float>::infinity());
   rayStats_.assign(load.count, QueryStats{});
   const uint64_t seed = load.seed ^ (uint64_t(frame_) * 0x9E3779B97F4A7C15ull);
-  const int stage = scene_.settings.substeps * 5;
+  const int stage = scene_.settings.substeps * kStagesPerSubstep;
   jobs_.parallelFor(0, load.count, 64, [&](uint32_t begin, uint32_t end) {
     ProfileZone zone(profiler_, "rays", stage);
     for (uint32_t k = begin; k < end; ++k) {
@@ -830,9 +850,29 @@ void World::fireRays() {
   stats_.raysMs = msSince(t);
 }
 
+// After grid edits: bodies resting on an edited grid wake up (a removed brick must let them
+// fall), and the pair cache forgets every pair with an edited grid (its cached contacts may
+// belong to a brick that is gone).
+void World::applyGridEdits() {
+  if (editedGrids_.empty()) return;
+  std::vector<uint8_t> edited(grids_.size(), 0);
+  for (uint32_t g : editedGrids_) edited[g] = 1;
+  editedGrids_.clear();
+  auto usesEdited = [&](uint32_t body) { return bodies_.shape[body].isGrid() && edited[bodies_.shape[body].grid]; };
+  for (const BodyPair& p : pairs_) {
+    if (!usesEdited(p.a) && !usesEdited(p.b)) continue;
+    for (uint32_t x : {p.a, p.b}) {
+      asleep_[x] = 0;
+      stillTime_[x] = 0.f;
+    }
+  }
+  std::erase_if(pairCache_, [&](const PairCacheEntry& e) { return usesEdited(e.pair.a) || usesEdited(e.pair.b); });
+}
+
 void World::step() {
   const auto t = Clock::now();
   stats_ = StepStats{};
+  applyGridEdits();
   profiler_.beginFrame(frame_);
   const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
   for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt, s);

@@ -64,7 +64,10 @@ class World {
   const BrickGrid& grid(uint32_t index) const { return *grids_[index]; }
   /// A grid to edit (place or remove bricks) between steps; every body using it sees the edit
   /// at the next step. Not while step() runs.
-  BrickGrid& editGrid(uint32_t index) { return *grids_[index]; }
+  BrickGrid& editGrid(uint32_t index) {
+    editedGrids_.push_back(index);
+    return *grids_[index];
+  }
   /// Hash of every body's position, rotation and velocities (bit patterns).
   uint64_t stateHash() const;
   /// Kinetic plus potential energy of the dynamic bodies (for drift checks).
@@ -95,7 +98,7 @@ class World {
     // Angular response per unit impulse along n, t1, t2 (inverse inertia x (r x d)), computed
     // once per substep so iterations are multiply-adds.
     Vec3f angA[3], angB[3];
-    float massN, massT1, massT2, bias, friction;
+    float massN, massT1, massT2, bias, relaxBias, friction;
     float lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0;
   };
   // A pair's contacts kept in both bodies' frames, reused while their relative pose barely
@@ -129,13 +132,15 @@ class World {
   void computeBounds();
   void generateContacts(float dt);
   void prepareSolver(float dt);
-  void solve();
-  void solveIsland(uint32_t island);
-  void solveIslandInColours(uint32_t island);
+  void solve(bool relax);
+  void solveIsland(uint32_t island, bool relax);
+  void solveIslandInColours(uint32_t island, bool relax);
   void colourIsland(uint32_t island);
   void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
   void warmStart(const SolverContact& s);
-  void solveContact(SolverContact& s);
+  void solveContact(SolverContact& s, bool relax);
+  // Profiling stages per substep: broadphase, contacts, prepare, solve, integrate, relax.
+  static constexpr int kStagesPerSubstep = 6;
   // Islands with more contacts than this are solved colour by colour on every thread.
   static constexpr uint32_t kSplitContacts = 512;
   static constexpr uint32_t kMaxColours = 64;
@@ -181,6 +186,8 @@ class World {
   std::vector<CachedContact> pairCacheContacts_, nextPairCacheContacts_;
   std::vector<int32_t> pairCacheHit_;  // per pair slot: index into pairCache_ or -1
   void updatePairCache();
+  std::vector<uint32_t> editedGrids_;  // grids handed out by editGrid() since the last step
+  void applyGridEdits();
   StepStats stats_;
   std::vector<float> rayHitT_;  // per ray of the ray load: closest hit (inf: none)
   std::vector<QueryStats> rayStats_;

@@ -175,6 +175,9 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
       ->check(CLI::IsMember({"brickworld", "bullet", "both"}));
   cmd.add_option("--sleeping", scene->sleeping, "scene: on/off overrides the scene's sleeping setting")
       ->check(CLI::IsMember({"on", "off"}));
+  cmd.add_option("--drift-after", scene->driftAfter,
+                 "scene: report the largest displacement of a dynamic body from this frame to the end (stacks at rest)")
+      ->check(CLI::Range(1u, 10'000'000u));
   cmd.add_flag("--json", *json, "print one JSON object");
   return [=] {
     if (*workload == "pool") return runPoolStress(*elements ? *elements : 10'000'000, *seed, *json);

@@ -109,8 +109,10 @@ int runScene(const SceneRunOptions& o) {
     csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,rays_ms,pairs,contacts,box_tests,ray_hits\n";
   }
   double work = 0, span = 0;
+  std::vector<Vec3d> settled;  // positions at --drift-after
   const auto tRun = Clock::now();
   for (uint32_t f = 0; f < frames; ++f) {
+    if (o.driftAfter && f == o.driftAfter) settled = world.bodies().position;
     world.step();
     const StepStats& s = world.lastStats();
     total.v.push_back(s.totalMs);
@@ -155,6 +157,9 @@ int runScene(const SceneRunOptions& o) {
     (bodies.linearVelocity[i].norm() < 0.05f && bodies.angularVelocity[i].norm() < 0.1f ? resting : moving)++;
     lowest = std::min(lowest, bodies.position[i].z());
   }
+  double drift = 0;
+  for (uint32_t i = 0; i < settled.size(); ++i)
+    if (bodies.motion[i] == MotionType::Dynamic) drift = std::max(drift, (bodies.position[i] - settled[i]).norm());
   auto stage = [](const Series& s) { return nlohmann::json{{"median_ms", s.quantile(0.5)}, {"p95_ms", s.quantile(0.95)}, {"max_ms", s.max()}}; };
   if (o.json) {
     nlohmann::json j{{"scene", scene.name},
@@ -181,6 +186,7 @@ int runScene(const SceneRunOptions& o) {
                      {"dynamic_moving", moving},
                      {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
                      {"state_hash", world.stateHash()}};
+    if (!settled.empty()) j["drift_after_frame"] = {{"frame", o.driftAfter}, {"max_displacement_m", drift}};
     if (!scene.terrains.empty()) {
       j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
       j["dynamic_floating"] = floating;
@@ -220,6 +226,8 @@ int runScene(const SceneRunOptions& o) {
     std::printf("  terrain: %.0f contacts per frame, %u bodies in water at the end\n", double(terrainContacts) / frames, floating);
   std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
               world.sleepingCount(), moving, std::isfinite(lowest) ? lowest : 0.0);
+  if (!settled.empty())
+    std::printf("  drift: largest displacement of a dynamic body from frame %u to the end %.3f mm\n", o.driftAfter, drift * 1e3);
   std::printf("  peak memory %.0f MiB; state hash %016llx\n", peakResidentMiB(), (unsigned long long)world.stateHash());
   std::printf("  work %.1f ms, span %.1f ms over the run\n", work, span);
   if (!o.csvPath.empty()) std::printf("  per-frame CSV: %s\n", o.csvPath.c_str());

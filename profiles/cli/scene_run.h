@@ -6,6 +6,7 @@
 namespace bw::cli {
 
 struct SceneRunOptions {
+  uint32_t driftAfter = 0;  ///< report how far dynamic bodies move from this frame to the end (0: off)
   std::string scene;        ///< path, or the name of a scene in profiles/scenes
   uint32_t frames = 0;      ///< 0: the scene's own setting
   int threads = 1;
@@ -13,8 +14,8 @@ struct SceneRunOptions {
   std::string tracePath;    ///< Chrome trace of the whole run
   bool json = false;
   bool progress = true;
-  std::string engine = "brickworld";
-  std::string sleeping;     ///< "on"/"off" overrides the scene's setting; empty keeps it  ///< brickworld, bullet, or both (same initial state, ratio printed)
+  std::string engine = "brickworld";  ///< brickworld, bullet, or both (same initial state, ratio printed)
+  std::string sleeping;     ///< "on"/"off" overrides the scene's setting; empty keeps it
 };
 
 /// Runs the scene and prints the report; returns the process exit code.
