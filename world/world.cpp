@@ -566,13 +566,33 @@ void World::buildIslands() {
 // Applies impulse `lambda` along direction d (0 normal, 1 and 2 tangents) to the contact's
 // dynamic bodies (static and kinematic bodies are read, never written).
 void World::applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda) {
-  if (bodies_.motion[s.a] == MotionType::Dynamic) {
-    bodies_.linearVelocity[s.a] += dir * (lambda * bodies_.inverseMass[s.a]);
-    bodies_.angularVelocity[s.a] += s.angA[d] * lambda;
+  SolverBody& a = solverBodies_[s.a];
+  SolverBody& b = solverBodies_[s.b];
+  if (a.dynamic) {
+    a.v += dir * (lambda * a.invMass);
+    a.w += s.angA[d] * lambda;
   }
-  if (bodies_.motion[s.b] == MotionType::Dynamic) {
-    bodies_.linearVelocity[s.b] -= dir * (lambda * bodies_.inverseMass[s.b]);
-    bodies_.angularVelocity[s.b] -= s.angB[d] * lambda;
+  if (b.dynamic) {
+    b.v -= dir * (lambda * b.invMass);
+    b.w -= s.angB[d] * lambda;
+  }
+}
+
+// The solver works on a compact copy of the bodies' velocities (one 32-byte record per body
+// instead of five arrays); copied in before solving, out after.
+void World::loadSolverBodies() {
+  const uint32_t n = bodies_.size();
+  solverBodies_.resize(n);
+  for (uint32_t i = 0; i < n; ++i)
+    solverBodies_[i] = {bodies_.linearVelocity[i], bodies_.inverseMass[i], bodies_.angularVelocity[i],
+                        bodies_.motion[i] == MotionType::Dynamic ? 1u : 0u};
+}
+
+void World::storeSolverBodies() {
+  for (uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (!solverBodies_[i].dynamic) continue;
+    bodies_.linearVelocity[i] = solverBodies_[i].v;
+    bodies_.angularVelocity[i] = solverBodies_[i].w;
   }
 }
 
@@ -585,10 +605,9 @@ void World::warmStart(const SolverContact& s) {
 // One Gauss-Seidel update of one contact: normal impulse clamped at zero, then friction
 // clamped by the Coulomb bound.
 void World::solveContact(SolverContact& s, bool relax) {
-  auto relative = [&] {
-    return Vec3f(bodies_.linearVelocity[s.a] + bodies_.angularVelocity[s.a].cross(s.rA) - bodies_.linearVelocity[s.b] -
-                 bodies_.angularVelocity[s.b].cross(s.rB));
-  };
+  const SolverBody& a = solverBodies_[s.a];
+  const SolverBody& b = solverBodies_[s.b];
+  auto relative = [&] { return Vec3f(a.v + a.w.cross(s.rA) - b.v - b.w.cross(s.rB)); };
   const float oldN = s.lambdaN;
   s.lambdaN = std::max(oldN + s.massN * ((relax ? s.relaxBias : s.bias) - relative().dot(s.normal)), 0.f);
   applyImpulse(s, 0, s.normal, s.lambdaN - oldN);
@@ -773,7 +792,9 @@ void World::substep(float dt, int index) {
       buildIslands();
     }
     ProfileZone z(profiler_, "solve (stage)");
+    loadSolverBodies();
     solve(false);
+    storeSolverBodies();
   }
   stats_.solverMs += msSince(t);
   t = Clock::now();
@@ -788,6 +809,7 @@ void World::substep(float dt, int index) {
     // bodies carry into the next substep.
     ProfileZone z(profiler_, "relax (stage)");
     solve(true);
+    storeSolverBodies();
   }
   stats_.solverMs += msSince(t);
   updateSleep(dt);

@@ -138,6 +138,8 @@ class World {
   void colourIsland(uint32_t island);
   void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
   void warmStart(const SolverContact& s);
+  void loadSolverBodies();
+  void storeSolverBodies();
   void solveContact(SolverContact& s, bool relax);
   // Profiling stages per substep: broadphase, contacts, prepare, solve, integrate, relax.
   static constexpr int kStagesPerSubstep = 6;
@@ -172,6 +174,14 @@ class World {
   std::vector<uint8_t> pairFlipped_;                // slot's contacts have normal from pair.a to pair.b
   std::vector<ContactStats> pairStats_;
   std::vector<SolverContact> contacts_;
+  struct SolverBody {
+    Vec3f v;            // 12 linear velocity
+    float invMass;      // 4
+    Vec3f w;            // 12 angular velocity (world)
+    uint32_t dynamic;   // 4  0: static or kinematic (read, never written)
+  };
+  static_assert(sizeof(SolverBody) == 32);
+  std::vector<SolverBody> solverBodies_;
   std::vector<Mat3f> inverseInertiaWorld_;          // per body, this substep
   std::vector<uint32_t> islandOf_;                  // union-find parent per body
   std::vector<uint32_t> islandStart_, islandContacts_;  // contacts grouped by island (CSR)
