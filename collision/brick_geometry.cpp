@@ -225,7 +225,9 @@ bool rayBrick(const Brick& b, const Ray& gridRay, float tMax, float& t, Vec3f& n
     if (t0 > t1) return false;
   }
   t = t0;
-  normal = entry >= 0 ? b.rotation.apply(planes[entry].n) : Vec3f(-gridRay.dir.normalized());
+  // note: stableNormalized, because normalized() squares the direction first: a huge (1e30) or
+  // tiny (1e-30, denormal) direction over/underflows and gave a zero or non-unit normal.
+  normal = entry >= 0 ? b.rotation.apply(planes[entry].n) : Vec3f(-gridRay.dir.stableNormalized());
   return true;
 }
 

@@ -1,11 +1,22 @@
 #include "collision/brick_grid.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "collision/input_validation.h"
 
 namespace bw {
+
+// A few ulps of the largest coordinate a ray or sweep query involves (the grid's bounds and the
+// query's own point): covers the rounding differences between slab tests and exact shape tests.
+float BrickGrid::roundingMargin(const Vec3f& queryPoint) const {
+  const Aabb all = index_.rootBounds();
+  float reach = queryPoint.cwiseAbs().maxCoeff();
+  if (!all.isEmpty()) reach = std::max({reach, all.min.cwiseAbs().maxCoeff(), all.max.cwiseAbs().maxCoeff()});
+  return reach * 0x1p-20f + std::numeric_limits<float>::min();
+}
 
 BrickGrid::BrickGrid(const Config& config)
     : config_(config),
@@ -68,10 +79,21 @@ MassProperties BrickGrid::massProperties() const {
 GridRayHit BrickGrid::raycast(const Ray& ray, uint32_t mask, QueryStats* stats) const {
   requireFinite(ray.origin, "BrickGrid::raycast", "ray.origin");
   requireFinite(ray.dir, "BrickGrid::raycast", "ray.dir");
-  const RayHit h = index_.raycastClosest(ray, mask, stats, [&](uint32_t e, float, float tMax, float& tHit) {
-    Vec3f n;
-    return rayBrick(brick(index_.payload(e)), ray, tMax, tHit, n);
-  });
+  if (ray.parallelMask == 7)
+    throw InvalidInput("BrickGrid::raycast: ray.dir has zero length (every component is zero or denormal)");
+  if (!(ray.maxT >= 0.f))
+    throw InvalidInput("BrickGrid::raycast: ray.maxT is " + std::to_string(ray.maxT) + ", expected >= 0 (+inf: unlimited)");
+  // note: the index's slab tests (bounds times 1/dir) and rayBrick (plane distances divided in the
+  // brick's frame) round differently, so by one ulp the index could reject a brick the ray only
+  // grazes, or whose exact entry ties the best hit. Traversing bounds grown by a few ulps of the
+  // largest coordinate involved keeps the index conservative: every brick rayBrick hits within
+  // maxT is tested, so the result is rayBrick's smallest t, ties going to the lowest handle.
+  const RayHit h = index_.sweepClosest(ray, Vec3f::Constant(roundingMargin(ray.origin)), mask,
+                                       [&](uint32_t e, float, float tMax, float& tHit) {
+                                         Vec3f n;
+                                         return rayBrick(brick(index_.payload(e)), ray, tMax, tHit, n);
+                                       },
+                                       stats);
   GridRayHit out;
   if (!h.hit()) return out;
   out.brick = index_.payload(h.element);
@@ -87,7 +109,13 @@ GridSweepHit BrickGrid::sweep(const QueryShape& shape, const Quatf& rotation, co
   requireFinite(from, "BrickGrid::sweep", "from");
   requireFinite(to, "BrickGrid::sweep", "to");
   requireUnitQuaternion(rotation, "BrickGrid::sweep", "rotation");
-  const Vec3f grow = rotation.toRotationMatrix().cwiseAbs() * shape.localHalfExtents();
+  // note: sweepShapeBrick stops within its gap tolerance (1e-4 x (1 + brick half size)) of first
+  // touch, possibly earlier in t than where the bounds meet; growing the traversed bounds by the
+  // largest such tolerance (bounded by half the grid's extent) and a rounding margin keeps the
+  // index conservative, so the result is the smallest fraction over every brick.
+  const float tolerance = 1e-4f * (1.f + 0.5f * index_.rootBounds().extent().cwiseMax(0.f).maxCoeff());
+  const Vec3f grow = rotation.toRotationMatrix().cwiseAbs() * shape.localHalfExtents() +
+                     Vec3f::Constant(tolerance + roundingMargin(from));
   const Ray ray = Ray::make(from, to - from, 1.f);
   GridSweepHit out;
   const RayHit h = index_.sweepClosest(ray, grow, mask,
@@ -106,6 +134,12 @@ GridSweepHit BrickGrid::sweep(const QueryShape& shape, const Quatf& rotation, co
 }
 
 void BrickGrid::overlapBricks(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats) const {
+  // note: infinite bounds are accepted (an unbounded box, or Aabb::empty()); NaN would silently
+  // overlap nothing.
+  for (int i = 0; i < 3; ++i) {
+    if (std::isnan(box.min[i])) throw InvalidInput(std::string("BrickGrid::overlapBricks: box.min.") + "xyz"[i] + " is NaN");
+    if (std::isnan(box.max[i])) throw InvalidInput(std::string("BrickGrid::overlapBricks: box.max.") + "xyz"[i] + " is NaN");
+  }
   index_.overlap(box, mask, [&](uint32_t e) { out.push_back(index_.payload(e)); }, stats);
 }
 
@@ -152,6 +186,7 @@ size_t BrickGrid::collide(const RigidTransform& gridPose, const QueryShape& shap
   if (params.maxContacts < 1 || params.maxContacts > 64)
     throw InvalidInput("BrickGrid::collide: params.maxContacts is " + std::to_string(params.maxContacts) + ", expected 1..64");
   requireInRange(params.lodFraction, 0.0, 1.0, "BrickGrid::collide", "params.lodFraction");
+  requireFinite(params.speculativeMargin, "BrickGrid::collide", "params.speculativeMargin");
   const LocalPose pose{gridPose.pointToLocal(shapePose.translation), gridPose.rotationToLocal(shapePose.rotation).normalized()};
   scratch.raw.clear();
   collideLocal(shape, pose, params, scratch.raw, stats);

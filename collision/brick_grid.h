@@ -117,14 +117,19 @@ class BrickGrid {
   MassProperties massProperties() const;
 
   // ---- queries (grid frame) ----
-  /// Closest hit on real brick shapes.
+  /// Closest hit on real brick shapes: exactly the smallest rayBrick() t over every brick within
+  /// [0, ray.maxT] (faces are closed, so grazing counts), ties going to the lowest OctoBVH handle.
+  /// InvalidInput for a non-finite origin or direction, a direction whose components are all
+  /// zero or denormal, or a NaN or negative maxT.
   GridRayHit raycast(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr) const;
   /// First time of impact of a shape (fixed rotation, grid frame) moving from `from` to `to`:
   /// a ray traversal against bounds grown by the shape's extents, then conservative advancement
-  /// (GJK distances) against each candidate brick's real shape.
+  /// (GJK distances) against each candidate brick's real shape. The fraction is exactly the
+  /// smallest sweepShapeBrick() fraction over every brick; a zero motion tests the start pose.
   GridSweepHit sweep(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to, uint32_t mask,
                      QueryStats* stats = nullptr) const;
-  /// Bricks whose bounds overlap box (ids appended).
+  /// Bricks whose bounds overlap box (ids appended). InvalidInput for NaN bounds; infinite
+  /// bounds are fine.
   void overlapBricks(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats = nullptr) const;
 
   // ---- contacts ----
@@ -159,6 +164,8 @@ class BrickGrid {
     ConvexApproximation value;
   };
   std::array<CachedApproximation, 8> approximations_;
+
+  float roundingMargin(const Vec3f& queryPoint) const;
 };
 
 /// Grid vs grid (article 000): the grid with fewer bricks collides as its convex approximation
