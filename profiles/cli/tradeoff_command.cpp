@@ -180,9 +180,10 @@ RunResult runOnce(const SceneDescription& scene, int threads, uint32_t frames, c
   return r;
 }
 
-int runTradeoff(const std::string& sceneName, uint32_t framesOption, int threads, const std::string& only, const std::string& csvPath,
-                bool json) {
-  const SceneDescription scene = loadScene(resolveScenePath(sceneName));
+int runTradeoff(const std::string& sceneName, uint32_t framesOption, int threads, const std::string& only, const std::string& sleeping,
+                const std::string& csvPath, bool json) {
+  SceneDescription scene = loadScene(resolveScenePath(sceneName));
+  if (!sleeping.empty()) scene.settings.sleeping = sleeping == "on";
   const uint32_t frames = framesOption ? framesOption : scene.settings.frames;
   SceneDescription refScene = scene;
   refScene.settings = referenceSettings(scene.settings);
@@ -264,6 +265,8 @@ CommandRegistration reg{"tradeoff", "Cost against error for each speed/accuracy 
   auto knob = std::make_shared<std::string>();
   auto csv = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
+  auto sleeping = std::make_shared<std::string>();
+  cmd.add_option("--sleeping", *sleeping, "on/off overrides the scene's sleeping setting")->check(CLI::IsMember({"on", "off"}));
   cmd.add_option("scene", *scene, "scene file or shipped scene name (default crates_on_grid)");
   cmd.add_option("--frames", *frames, "frames per run (default: the scene's)")->check(CLI::Range(1u, 10'000'000u));
   cmd.add_option("--threads", *threads, "threads (default 1)")->check(CLI::Range(1, 1024));
@@ -271,7 +274,7 @@ CommandRegistration reg{"tradeoff", "Cost against error for each speed/accuracy 
                                   "pair_cache_tolerance)");
   cmd.add_option("--csv", *csv, "CSV to write (default tradeoff_<scene>.csv)");
   cmd.add_flag("--json", *json, "print one JSON object");
-  return [=] { return runTradeoff(*scene, *frames, *threads, *knob, *csv, *json); };
+  return [=] { return runTradeoff(*scene, *frames, *threads, *knob, *sleeping, *csv, *json); };
 }};
 
 }  // namespace
