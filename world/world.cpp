@@ -561,6 +561,12 @@ void World::buildIslands() {
   islandContacts_.resize(contacts_.size());
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
   for (uint32_t k = 0; k < contacts_.size(); ++k) islandContacts_[fill[rootIndex[islandOfContact(contacts_[k])]]++] = k;
+  // note: the contacts are moved into island order once, so every solver iteration streams
+  // through memory instead of jumping between islands (the solve order is unchanged).
+  orderedContacts_.resize(contacts_.size());
+  for (uint32_t k = 0; k < contacts_.size(); ++k) orderedContacts_[k] = contacts_[islandContacts_[k]];
+  std::swap(contacts_, orderedContacts_);
+  for (uint32_t k = 0; k < contacts_.size(); ++k) islandContacts_[k] = k;
 }
 
 // Applies impulse `lambda` along direction d (0 normal, 1 and 2 tangents) to the contact's
