@@ -147,7 +147,6 @@ void World::buildTerrain(const TerrainDescription& t) {
   }
   VoxTerrainOptions options;
   options.voxelSize = t.voxelSize;
-  options.placement = RigidTransform{t.position, Quatf::Identity()};
   VoxTerrain built;
   try {
     built = buildVoxTerrain(loadVox(t.file), materials, options);

@@ -7,15 +7,15 @@
 ///   for (int f = 0; f < 300; ++f) world.step();
 ///   std::printf("%016llx\n", (unsigned long long)world.stateHash());
 ///
-/// What is in this first version: static, kinematic and dynamic bodies (primitives and grids,
-/// grids shared between copies), sweep-and-prune broadphase, primitive-vs-grid, grid-vs-grid
-/// (convex approximation) and primitive-vs-primitive contacts with speculative margins, a
-/// sequential-impulse solver with friction, restitution and warm starting matched by contact
-/// feature, islands (union-find over contacts) solved in parallel, sleeping islands, and
-/// semi-implicit Euler integration with substeps. Islands above kSplitContacts contacts are
-/// coloured (no two contacts of a colour share a dynamic body) and solved colour by colour on
-/// every thread, so one big pile still uses them all. Terrains (MagicaVoxel models) are static bodies whose pairs run on one thread (their
-/// chunk cache is filled by queries); water voxels float bodies (buoyancy and drag).
+/// What it has: static, kinematic and dynamic bodies (primitives, grids shared between copies,
+/// voxel terrains), sweep-and-prune broadphase, primitive-vs-grid, grid-vs-grid (convex
+/// approximation), box-vs-box manifolds, other primitive pairs and terrain contacts, all with
+/// speculative margins, a pair cache, a sequential-impulse solver (friction, restitution, warm
+/// starting matched by contact feature, a relax pass after integration), islands solved in
+/// parallel, islands above kSplitContacts coloured (no two contacts of a colour share a dynamic
+/// body) and solved colour by colour on every thread, sleeping, and substeps. Terrain pairs run
+/// on one thread (the chunk cache is filled by queries); water voxels float bodies. Thread
+/// safety: one step() at a time; editGrid() and probeContacts() only between steps.
 #include <cstdint>
 #include <memory>
 #include <vector>
