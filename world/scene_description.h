@@ -88,6 +88,7 @@ struct SceneSettings {
   int substeps = 1;
   int solverIterations = 8;
   int relaxIterations = 2;           ///< velocity iterations after integration without push-out
+  bool shockPropagation = false;     ///< a last bottom-up sweep treating the lower body as immovable
   uint32_t frames = 300;
   float lodFraction = 1.f / 16;
   int approximationDepth = 3;

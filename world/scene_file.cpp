@@ -234,7 +234,7 @@ SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescriptio
 
 SceneSettings parseSettings(const Field& f) {
   f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping",
-               "manifold_size", "reuse_translation", "reuse_rotation", "relax_iterations"});
+               "manifold_size", "reuse_translation", "reuse_rotation", "relax_iterations", "shock_propagation"});
   SceneSettings s;
   if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-scene_limits::kMaxGravity, scene_limits::kMaxGravity);
   if (f.has("timestep")) s.timestep = f.at("timestep").number(scene_limits::kMinTimestep, scene_limits::kMaxTimestep);
@@ -244,6 +244,7 @@ SceneSettings parseSettings(const Field& f) {
   if (f.has("lod_fraction")) s.lodFraction = float(f.at("lod_fraction").number(0, 1));
   if (f.has("approximation_depth")) s.approximationDepth = int(f.at("approximation_depth").integer(0, 7));
   if (f.has("sleeping")) s.sleeping = f.at("sleeping").boolean();
+  if (f.has("shock_propagation")) s.shockPropagation = f.at("shock_propagation").boolean();
   if (f.has("relax_iterations")) s.relaxIterations = int(f.at("relax_iterations").integer(0, 64));
   if (f.has("manifold_size")) s.manifoldSize = int(f.at("manifold_size").integer(1, 64));
   if (f.has("reuse_translation")) s.reuseTranslation = f.at("reuse_translation").number(0, 1);

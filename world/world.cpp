@@ -485,6 +485,20 @@ void World::prepareSolver(float dt) {
       s.massN = masses[0];
       s.massT1 = masses[1];
       s.massT2 = masses[2];
+      if (scene_.settings.shockPropagation && bodies_.motion[a] == MotionType::Dynamic && bodies_.motion[b] == MotionType::Dynamic) {
+        // The lower body (along gravity) is the support: in the shock sweep only the upper one moves.
+        const Vec3d up = -scene_.settings.gravity.normalized();
+        const double ha = up.dot(bodies_.position[a]), hb = up.dot(bodies_.position[b]);
+        if (std::isfinite(ha) && std::abs(ha - hb) > 1e-3) {
+          s.shockLower = ha < hb ? 1 : 2;
+          s.height = std::min(ha, hb);
+          for (int d = 0; d < 3; ++d) {
+            const float k = s.shockLower == 1 ? bodies_.inverseMass[b] + s.angB[d].cross(s.rB).dot(dirs[d])
+                                              : bodies_.inverseMass[a] + s.angA[d].cross(s.rA).dot(dirs[d]);
+            s.shockMass[d] = k > 0 ? 1.f / k : 0.f;
+          }
+        }
+      }
       s.friction = std::sqrt(bodies_.friction[a] * bodies_.friction[b]);
       const Vec3f vRel = bodies_.linearVelocity[a] + bodies_.angularVelocity[a].cross(s.rA) - bodies_.linearVelocity[b] -
                          bodies_.angularVelocity[b].cross(s.rB);
@@ -625,6 +639,54 @@ void World::solveContact(SolverContact& s, bool relax) {
   applyImpulse(s, 2, s.t2, s.lambdaT2 - o2);
 }
 
+// Shock propagation (Guendelman et al.): after the iterations, one sweep from the bottom of the
+// pile up in which each contact treats its lower body as immovable, so a heavy body cannot push
+// a light one below it into the ground (the 1000:1 mass-ratio stack). Only the upper body's
+// velocity changes; the accumulated impulses keep their clamps.
+void World::solveContactShock(SolverContact& s) {
+  SolverBody& a = solverBodies_[s.a];
+  SolverBody& b = solverBodies_[s.b];
+  SolverBody& upper = s.shockLower == 1 ? b : a;
+  auto relative = [&] { return Vec3f(a.v + a.w.cross(s.rA) - b.v - b.w.cross(s.rB)); };
+  // Impulse along dir on the upper body only (a receives +, b receives -).
+  auto push = [&](int d, const Vec3f& dir, float lambda) {
+    if (s.shockLower == 1) {
+      upper.v -= dir * (lambda * upper.invMass);
+      upper.w -= s.angB[d] * lambda;
+    } else {
+      upper.v += dir * (lambda * upper.invMass);
+      upper.w += s.angA[d] * lambda;
+    }
+  };
+  const float oldN = s.lambdaN;
+  s.lambdaN = std::max(oldN + s.shockMass[0] * (s.bias - relative().dot(s.normal)), 0.f);
+  push(0, s.normal, s.lambdaN - oldN);
+  const float limit = s.friction * s.lambdaN;
+  const Vec3f v = relative();
+  const float o1 = s.lambdaT1, o2 = s.lambdaT2;
+  s.lambdaT1 = std::clamp(o1 - s.shockMass[1] * v.dot(s.t1), -limit, limit);
+  s.lambdaT2 = std::clamp(o2 - s.shockMass[2] * v.dot(s.t2), -limit, limit);
+  push(1, s.t1, s.lambdaT1 - o1);
+  push(2, s.t2, s.lambdaT2 - o2);
+}
+
+// The island's contacts bottom-up (by the lower body's height, ties by index: deterministic):
+// contacts with a static or kinematic body first (they are the ground), then dynamic pairs.
+void World::shockSweep(std::vector<uint32_t>& list) {
+  std::stable_sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) {
+    const SolverContact& p = contacts_[x];
+    const SolverContact& q = contacts_[y];
+    if ((p.shockLower == 0) != (q.shockLower == 0)) return p.shockLower == 0;
+    return p.height < q.height;
+  });
+  for (uint32_t k : list) {
+    if (contacts_[k].shockLower)
+      solveContactShock(contacts_[k]);
+    else
+      solveContact(contacts_[k], false);  // against the ground (or side by side): a normal update
+  }
+}
+
 void World::solveIsland(uint32_t island, bool relax) {
   const uint32_t begin = islandStart_[island], end = islandStart_[island + 1];
   if (!relax)
@@ -637,6 +699,11 @@ void World::solveIsland(uint32_t island, bool relax) {
       const uint32_t k = (it & 1) ? end - 1 - (j - begin) : j;
       solveContact(contacts_[islandContacts_[k]], relax);
     }
+  }
+  if (!relax && scene_.settings.shockPropagation) {
+    thread_local std::vector<uint32_t> list;  // note: per worker thread, reused across islands
+    list.assign(islandContacts_.begin() + begin, islandContacts_.begin() + end);
+    shockSweep(list);
   }
 }
 
@@ -695,6 +762,10 @@ void World::solveIslandInColours(uint32_t island, bool relax) {
         for (uint32_t j = cb; j < ce; ++j) solveContact(contacts_[colourContacts_[j]], relax);
       });
     }
+  }
+  if (!relax && scene_.settings.shockPropagation) {  // one serial sweep over the whole pile
+    std::vector<uint32_t> list(colourContacts_.begin(), colourContacts_.end());
+    shockSweep(list);
   }
 }
 

@@ -99,6 +99,11 @@ class World {
     // once per substep so iterations are multiply-adds.
     Vec3f angA[3], angB[3];
     float massN, massT1, massT2, bias, relaxBias, friction;
+    // Shock propagation: effective masses with the lower body immovable, which body is lower
+    // along gravity (0 none, 1 a, 2 b) and the contact's height (for the bottom-up order).
+    float shockMass[3];
+    uint8_t shockLower = 0;
+    double height = 0;
     float lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0;
   };
   // A pair's contacts kept in both bodies' frames, reused while their relative pose barely
@@ -141,6 +146,8 @@ class World {
   void loadSolverBodies();
   void storeSolverBodies();
   void solveContact(SolverContact& s, bool relax);
+  void solveContactShock(SolverContact& s);
+  void shockSweep(std::vector<uint32_t>& contacts);
   // Profiling stages per substep: broadphase, contacts, prepare, solve, integrate, relax.
   static constexpr int kStagesPerSubstep = 6;
   // Islands with more contacts than this are solved colour by colour on every thread.

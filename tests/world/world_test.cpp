@@ -80,3 +80,30 @@ TEST(World, StateIsIdenticalForAnyThreadCount) {
 
 }  // namespace
 }  // namespace bw
+
+namespace bw {
+namespace {
+
+// Shock propagation and big-island colouring together (a pile poured into a bin): the same
+// state for any thread count.
+TEST(World, ShockPropagationAndColouredIslandsAreIdenticalForAnyThreadCount) {
+  SceneDescription scene = loadScene(std::string(BW_SCENES_DIR) + "/crate_pile.json");
+  scene.settings.shockPropagation = true;
+  scene.spawners[0].count = 400;
+  scene.spawners[0].regionMax.z() = 8;
+  uint64_t reference = 0;
+  uint32_t split = 0;
+  for (int threads : {1, 2, 4}) {
+    World world(scene, threads);
+    for (int f = 0; f < 90; ++f) {
+      world.step();
+      if (threads == 1) split += world.lastStats().splitIslands;
+    }
+    if (threads == 1) reference = world.stateHash();
+    EXPECT_EQ(world.stateHash(), reference) << threads << " threads";
+  }
+  EXPECT_GT(split, 0u) << "the pile must form an island big enough to be coloured";
+}
+
+}  // namespace
+}  // namespace bw
