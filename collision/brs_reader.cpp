@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "collision/brick_geometry.h"
+#include "collision/byte_reader.h"
 #include "collision/input_validation.h"
 
 namespace bw {
@@ -29,36 +30,10 @@ constexpr size_t kMinRecordBytes = 5;
 // Reservations are capped so that a corrupt count cannot allocate ahead of the data that backs it.
 constexpr uint32_t kMaxReserve = 1u << 20;
 
-[[noreturn]] void fail(const std::string& file, const std::string& where, const std::string& problem) {
-  throw InvalidInput(file + ": " + where + ": " + problem);
-}
-
-// Bytes of one section (or of the whole file), read front to back with every read checked.
-class ByteReader {
+// A section's reader with the .brs string encoding.
+class BrsReader : public ByteReader {
  public:
-  ByteReader(const uint8_t* data, size_t size, const std::string& file, std::string where)
-      : data_(data), size_(size), file_(file), where_(std::move(where)) {}
-
-  size_t remaining() const { return size_ - pos_; }
-  size_t position() const { return pos_; }
-  const uint8_t* take(size_t n, const char* what) {
-    if (n > remaining())
-      fail(file_, where_,
-           std::string("truncated: ") + what + " needs " + std::to_string(n) + " bytes at offset " +
-               std::to_string(pos_) + ", only " + std::to_string(remaining()) + " left");
-    const uint8_t* p = data_ + pos_;
-    pos_ += n;
-    return p;
-  }
-  uint8_t u8(const char* what) { return *take(1, what); }
-  uint16_t u16(const char* what) {
-    const uint8_t* p = take(2, what);
-    return uint16_t(p[0] | (p[1] << 8));
-  }
-  int32_t i32(const char* what) {
-    const uint8_t* p = take(4, what);
-    return int32_t(uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24));
-  }
+  using ByteReader::ByteReader;
   // Latin-1 (positive length, NUL-terminated) or UTF-16 (negative length, low bytes kept).
   std::string string(const char* what) {
     const int32_t n = i32(what);
@@ -67,10 +42,9 @@ class ByteReader {
       const uint8_t* p = take(size_t(n), what);
       s.assign(reinterpret_cast<const char*>(p), size_t(n));
     } else {
-      if (n == std::numeric_limits<int32_t>::min()) fail(file_, where_, std::string(what) + " has an invalid length");
+      if (n == std::numeric_limits<int32_t>::min()) failHere(std::string(what) + " has an invalid length");
       const size_t units = size_t(-int64_t(n));
-      if (units > remaining() / 2)
-        fail(file_, where_, std::string("truncated: ") + what + " needs " + std::to_string(units * 2) + " bytes");
+      if (units > remaining() / 2) failHere(std::string("truncated: ") + what + " needs " + std::to_string(units * 2) + " bytes");
       const uint8_t* p = take(units * 2, what);
       s.resize(units);
       for (size_t i = 0; i < units; ++i) s[i] = char(p[2 * i]);
@@ -78,24 +52,6 @@ class ByteReader {
     while (!s.empty() && s.back() == '\0') s.pop_back();
     return s;
   }
-  // An array count, checked against the bytes left (each item takes at least minItemBytes).
-  uint32_t count(const char* what, size_t minItemBytes) {
-    const int32_t n = i32(what);
-    if (n < 0) fail(file_, where_, std::string(what) + " count is negative (" + std::to_string(n) + ")");
-    if (size_t(n) > remaining() / minItemBytes)
-      fail(file_, where_,
-           std::string(what) + " count " + std::to_string(n) + " exceeds the data (" + std::to_string(remaining()) +
-               " bytes left)");
-    return uint32_t(n);
-  }
-  [[noreturn]] void failHere(const std::string& problem) const { fail(file_, where_, problem); }
-
- private:
-  const uint8_t* data_;
-  size_t size_;
-  size_t pos_ = 0;
-  const std::string& file_;
-  std::string where_;
 };
 
 // Reads one section header and returns its uncompressed bytes.
@@ -104,16 +60,16 @@ std::vector<uint8_t> readSection(ByteReader& file, const char* name, const std::
   const int32_t uncompressed = file.i32(where.c_str());
   const int32_t compressed = file.i32(where.c_str());
   if (uncompressed < 0 || compressed < 0 || uncompressed > kMaxSectionBytes)
-    fail(fileName, where,
+    failFile(fileName, where,
          "sizes out of range (uncompressed " + std::to_string(uncompressed) + ", compressed " +
              std::to_string(compressed) + ")");
   if (compressed > 0 && compressed >= uncompressed)
-    fail(fileName, where,
+    failFile(fileName, where,
          "compressed size " + std::to_string(compressed) + " is not below the uncompressed size " +
              std::to_string(uncompressed));
   const size_t stored = compressed > 0 ? size_t(compressed) : size_t(uncompressed);
   if (stored > file.remaining())
-    fail(fileName, where,
+    failFile(fileName, where,
          "truncated: needs " + std::to_string(stored) + " bytes at offset " + std::to_string(file.position()) +
              ", only " + std::to_string(file.remaining()) + " left");
   const uint8_t* p = file.take(stored, where.c_str());
@@ -125,7 +81,7 @@ std::vector<uint8_t> readSection(ByteReader& file, const char* name, const std::
   uLongf produced = uLongf(out.size());
   const int rc = uncompress(out.data(), &produced, p, uLong(compressed));
   if (rc != Z_OK || produced != out.size())
-    fail(fileName, where,
+    failFile(fileName, where,
          std::string("zlib data is corrupt (") + (rc == Z_OK ? "size mismatch" : zError(rc)) + ", expected " +
              std::to_string(uncompressed) + " bytes)");
   return out;
@@ -174,7 +130,7 @@ class BitReader {
     return (v & 1) ? magnitude : -magnitude;
   }
   [[noreturn]] void failHere(const std::string& problem) const {
-    fail(file_, "bricks section", "brick " + std::to_string(brick_) + ": " + problem);
+    failFile(file_, "bricks section", "brick " + std::to_string(brick_) + ": " + problem);
   }
 
  private:
@@ -356,7 +312,7 @@ struct Header1 {
 };
 
 Header1 readHeader1(const std::vector<uint8_t>& bytes, const std::string& file) {
-  ByteReader r(bytes.data(), bytes.size(), file, "header1");
+  BrsReader r(bytes.data(), bytes.size(), file, "header1");
   Header1 h;
   h.map = r.string("map name");
   h.author = r.string("author name");
@@ -377,25 +333,25 @@ struct Header2 {
 };
 
 Header2 readHeader2(const std::vector<uint8_t>& bytes, int version, const std::string& file) {
-  ByteReader r(bytes.data(), bytes.size(), file, "header2");
+  BrsReader r(bytes.data(), bytes.size(), file, "header2");
   Header2 h;
-  const uint32_t mods = r.count("mods", 4);
+  const uint32_t mods = r.count("mods count", 4);
   for (uint32_t i = 0; i < mods; ++i) r.string("mod name");
-  const uint32_t assets = r.count("brick assets", 4);
+  const uint32_t assets = r.count("brick assets count", 4);
   h.assets.reserve(assets);
   for (uint32_t i = 0; i < assets; ++i) h.assets.push_back(r.string("brick asset name"));
-  h.colors = r.count("colors", 4);
+  h.colors = r.count("colors count", 4);
   r.take(size_t(h.colors) * 4, "colors");
-  h.materials = r.count("materials", 4);
+  h.materials = r.count("materials count", 4);
   for (uint32_t i = 0; i < h.materials; ++i) r.string("material name");
-  h.owners = r.count("brick owners", 24);
+  h.owners = r.count("brick owners count", 24);
   for (uint32_t i = 0; i < h.owners; ++i) {
     r.take(16, "owner id");
     r.string("owner name");
     r.i32("owner brick count");
   }
   if (version >= 9) {
-    h.physicalMaterials = r.count("physical materials", 4);
+    h.physicalMaterials = r.count("physical materials count", 4);
     for (uint32_t i = 0; i < h.physicalMaterials; ++i) r.string("physical material name");
   }
   return h;
@@ -403,8 +359,8 @@ Header2 readHeader2(const std::vector<uint8_t>& bytes, int version, const std::s
 
 // Checks the components section's framing (count, names, lengths) without interpreting it.
 void checkComponents(const std::vector<uint8_t>& bytes, const std::string& file) {
-  ByteReader r(bytes.data(), bytes.size(), file, "components");
-  const uint32_t n = r.count("components", 8);
+  BrsReader r(bytes.data(), bytes.size(), file, "components");
+  const uint32_t n = r.count("components count", 8);
   for (uint32_t i = 0; i < n; ++i) {
     r.string("component name");
     const int32_t len = r.i32("component length");
@@ -436,16 +392,16 @@ const char* brickShapeName(BrickShape shape) {
 
 BrsLoadResult parseBrs(const uint8_t* data, size_t size, const std::string& name, float unitsPerBrsUnit) {
   if (!(unitsPerBrsUnit > 0.f) || !(unitsPerBrsUnit < 1e6f))
-    fail(name, "arguments", "unitsPerBrsUnit is " + std::to_string(unitsPerBrsUnit) + ", expected > 0");
-  if (data == nullptr && size != 0) fail(name, "arguments", "data is null");
-  if (size == 0) fail(name, "file", "is empty");
-  ByteReader file(data, size, name, "file");
+    failFile(name, "arguments", "unitsPerBrsUnit is " + std::to_string(unitsPerBrsUnit) + ", expected > 0");
+  if (data == nullptr && size != 0) failFile(name, "arguments", "data is null");
+  if (size == 0) failFile(name, "file", "is empty");
+  BrsReader file(data, size, name, "file");
   const uint8_t* magic = file.take(3, "magic");
-  if (std::memcmp(magic, "BRS", 3) != 0) fail(name, "file", "wrong magic (not a Brickadia save: expected \"BRS\")");
+  if (std::memcmp(magic, "BRS", 3) != 0) failFile(name, "file", "wrong magic (not a Brickadia save: expected \"BRS\")");
   BrsLoadResult out;
   out.version = file.u16("version");
   if (out.version < kMinVersion || out.version > kMaxVersion)
-    fail(name, "file",
+    failFile(name, "file",
          "unsupported version " + std::to_string(out.version) + " (supported: " + std::to_string(kMinVersion) + " to " +
              std::to_string(kMaxVersion) + ")");
   out.gameVersion = file.i32("game version");
@@ -466,10 +422,10 @@ BrsLoadResult parseBrs(const uint8_t* data, size_t size, const std::string& name
   // A record holds at least 42 bits (asset, size flag, three 8-bit packed positions, orientation,
   // flags, material, color flag, 8-bit owner) and starts on a byte boundary: at least 5 bytes.
   if (h1.brickCount > brickBytes.size() / kMinRecordBytes)
-    fail(name, "bricks section",
+    failFile(name, "bricks section",
          "brick count " + std::to_string(h1.brickCount) + " exceeds the data (" + std::to_string(brickBytes.size()) +
              " bytes hold at most " + std::to_string(brickBytes.size() / kMinRecordBytes) + " records)");
-  if (h1.brickCount > 0 && h2.assets.empty()) fail(name, "header2", "no brick assets for " + std::to_string(h1.brickCount) + " bricks");
+  if (h1.brickCount > 0 && h2.assets.empty()) failFile(name, "header2", "no brick assets for " + std::to_string(h1.brickCount) + " bricks");
   checkComponents(readSection(file, "components", name), name);
 
   std::vector<AssetMapping> mappings;
@@ -592,15 +548,15 @@ BrsLoadResult parseBrs(const uint8_t* data, size_t size, const std::string& name
 
 BrsLoadResult loadBrs(const std::string& path, float unitsPerBrsUnit) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "file", "cannot be opened");
+  if (!in) failFile(path, "file", "cannot be opened");
   in.seekg(0, std::ios::end);
   const std::streamoff end = in.tellg();
-  if (end < 0) fail(path, "file", "cannot be read");
-  if (end > std::streamoff(4) * kMaxSectionBytes) fail(path, "file", "is larger than 4 GiB");
+  if (end < 0) failFile(path, "file", "cannot be read");
+  if (end > std::streamoff(4) * kMaxSectionBytes) failFile(path, "file", "is larger than 4 GiB");
   std::vector<uint8_t> bytes(static_cast<size_t>(end));
   in.seekg(0, std::ios::beg);
   if (!bytes.empty() && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
-    fail(path, "file", "cannot be read");
+    failFile(path, "file", "cannot be read");
   return parseBrs(bytes.data(), bytes.size(), path, unitsPerBrsUnit);
 }
 

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <utility>
 
+#include "collision/byte_reader.h"
 #include "collision/input_validation.h"
 
 namespace bw {
@@ -18,10 +19,6 @@ namespace {
 constexpr int kChunkHeaderBytes = 12;
 // A .vox file holds at most a few hundred models of 256^3 voxels; anything above 2 GiB is not one.
 constexpr std::streamoff kMaxFileBytes = std::streamoff(1) << 31;
-
-[[noreturn]] void fail(const std::string& file, const std::string& where, const std::string& problem) {
-  throw InvalidInput(file + ": " + where + ": " + problem);
-}
 
 std::string int3Text(const Int3& v) {
   // note: appended piece by piece; "(" + std::to_string(...) trips GCC 12's false -Wrestrict.
@@ -35,34 +32,11 @@ std::string int3Text(const Int3& v) {
   return s;
 }
 
-// Bytes of one chunk's content, read front to back with every read checked.
-class ByteReader {
+// Bytes of one chunk's content, with the .vox string and DICT encodings.
+class ChunkReader : public ByteReader {
  public:
-  ByteReader(const uint8_t* data, size_t size, const std::string& file, std::string where)
-      : data_(data), size_(size), file_(file), where_(std::move(where)) {}
-
-  size_t remaining() const { return size_ - pos_; }
-  const uint8_t* take(size_t n, const char* what) {
-    if (n > remaining())
-      failHere(std::string("truncated: ") + what + " needs " + std::to_string(n) + " bytes at offset " +
-               std::to_string(pos_) + ", only " + std::to_string(remaining()) + " left");
-    const uint8_t* p = data_ + pos_;
-    pos_ += n;
-    return p;
-  }
-  int32_t i32(const char* what) {
-    const uint8_t* p = take(4, what);
-    return int32_t(uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24));
-  }
-  // A count of items taking at least minItemBytes each, checked against the bytes left.
-  uint32_t count(const char* what, size_t minItemBytes) {
-    const int32_t n = i32(what);
-    if (n < 0) failHere(std::string(what) + " is negative (" + std::to_string(n) + ")");
-    if (size_t(n) > remaining() / minItemBytes)
-      failHere(std::string(what) + " " + std::to_string(n) + " exceeds the chunk (" + std::to_string(remaining()) +
-               " bytes left)");
-    return uint32_t(n);
-  }
+  ChunkReader(const uint8_t* data, size_t size, const std::string& file, std::string where)
+      : ByteReader(data, size, file, std::move(where), "the chunk") {}
   std::string string(const char* what) {
     const uint32_t n = count(what, 1);
     const uint8_t* p = take(n, what);
@@ -77,14 +51,6 @@ class ByteReader {
     }
     return out;
   }
-  [[noreturn]] void failHere(const std::string& problem) const { fail(file_, where_, problem); }
-
- private:
-  const uint8_t* data_;
-  size_t size_;
-  size_t pos_ = 0;
-  const std::string& file_;
-  std::string where_;
 };
 
 std::array<VoxRgba, 256> makeDefaultPalette() {
@@ -177,7 +143,7 @@ class SceneWalker {
       : nodes_(nodes), models_(models), file_(file) {}
 
   void walk(std::vector<VoxInstance>& out, uint32_t& transformsApplied, uint32_t& ignoredRotations) {
-    if (!nodes_.count(0)) fail(file_, "scene graph", "has no root node 0");
+    if (!nodes_.count(0)) failFile(file_, "scene graph", "has no root node 0");
     visit(0, Int3{}, false, 0, out, transformsApplied);
     ignoredRotations = uint32_t(rotatedNodes_.size());
   }
@@ -186,19 +152,19 @@ class SceneWalker {
   void visit(int32_t id, Int3 t, bool rotated, int depth, std::vector<VoxInstance>& out, uint32_t& transforms) {
     const auto it = nodes_.find(id);
     if (it == nodes_.end())
-      fail(file_, "scene graph", "node " + std::to_string(id) + " is referenced but missing");
+      failFile(file_, "scene graph", "node " + std::to_string(id) + " is referenced but missing");
     if (depth >= kVoxMaxSceneDepth)
-      fail(file_, "scene graph", "path to node " + std::to_string(id) + " is deeper than " +
+      failFile(file_, "scene graph", "path to node " + std::to_string(id) + " is deeper than " +
                                      std::to_string(kVoxMaxSceneDepth) + " nodes");
     if (std::find(path_.begin(), path_.end(), id) != path_.end())
-      fail(file_, "scene graph", "cycle through node " + std::to_string(id));
+      failFile(file_, "scene graph", "cycle through node " + std::to_string(id));
     const SceneNode& n = it->second;
     if (n.kind == NodeKind::Transform) {
       ++transforms;
       t = {t.x + n.translation.x, t.y + n.translation.y, t.z + n.translation.z};
       for (int32_t c : {t.x, t.y, t.z})
         if (c < -kVoxMaxTranslation || c > kVoxMaxTranslation)
-          fail(file_, "scene graph", "translation " + int3Text(t) + " at node " + std::to_string(id) +
+          failFile(file_, "scene graph", "translation " + int3Text(t) + " at node " + std::to_string(id) +
                                          " is beyond +-" + std::to_string(kVoxMaxTranslation));
       if (n.rotated) {
         rotated = true;
@@ -207,10 +173,10 @@ class SceneWalker {
     }
     if (n.kind == NodeKind::Shape) {
       if (n.model < 0 || size_t(n.model) >= models_.size())
-        fail(file_, "scene graph", "nSHP node " + std::to_string(id) + " names model " + std::to_string(n.model) +
+        failFile(file_, "scene graph", "nSHP node " + std::to_string(id) + " names model " + std::to_string(n.model) +
                                        " of " + std::to_string(models_.size()));
       if (out.size() >= kVoxMaxInstances)
-        fail(file_, "scene graph", "expands to more than " + std::to_string(kVoxMaxInstances) + " instances");
+        failFile(file_, "scene graph", "expands to more than " + std::to_string(kVoxMaxInstances) + " instances");
       const Int3& s = models_[size_t(n.model)].size;
       VoxInstance inst;
       inst.model = uint32_t(n.model);
@@ -252,8 +218,8 @@ const std::array<VoxRgba, 256>& voxDefaultPalette() {
 }
 
 VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) {
-  if (data == nullptr && size != 0) fail(file, "file", "no data");
-  ByteReader header(data, size, file, "header");
+  if (data == nullptr && size != 0) failFile(file, "file", "no data");
+  ChunkReader header(data, size, file, "header");
   const uint8_t* magic = header.take(4, "magic \"VOX \"");
   if (magic[0] != 'V' || magic[1] != 'O' || magic[2] != 'X' || magic[3] != ' ')
     header.failHere("not a MagicaVoxel file (magic is \"" + chunkName(magic) + "\", expected \"VOX \")");
@@ -263,7 +229,7 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
 
   // MAIN chunk header.
   const size_t mainAt = 8;
-  ByteReader mainHeader(data + mainAt, size - mainAt, file, "MAIN chunk");
+  ChunkReader mainHeader(data + mainAt, size - mainAt, file, "MAIN chunk");
   const uint8_t* mainId = mainHeader.take(4, "chunk id");
   if (chunkName(mainId) != "MAIN")
     mainHeader.failHere("first chunk is \"" + chunkName(mainId) + "\", expected \"MAIN\"");
@@ -287,11 +253,11 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
   uint32_t chunkIndex = 0;
   while (pos < size_t(mainChildren)) {
     const std::string where = "chunk " + std::to_string(chunkIndex);
-    ByteReader head(children + pos, size_t(mainChildren) - pos, file, where);
+    ChunkReader head(children + pos, size_t(mainChildren) - pos, file, where);
     const uint8_t* idBytes = head.take(4, "chunk id");
     const std::string id = chunkName(idBytes);
     const std::string chunkWhere = id + " chunk " + std::to_string(chunkIndex);
-    ByteReader hdr(children + pos + 4, size_t(mainChildren) - pos - 4, file, chunkWhere);
+    ChunkReader hdr(children + pos + 4, size_t(mainChildren) - pos - 4, file, chunkWhere);
     const int32_t n = hdr.i32("content size");
     const int32_t m = hdr.i32("children size");
     if (n < 0 || m < 0)
@@ -299,7 +265,7 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
     if (uint64_t(n) + uint64_t(m) > hdr.remaining())
       hdr.failHere("content " + std::to_string(n) + " + children " + std::to_string(m) + " bytes exceed MAIN (" +
                    std::to_string(hdr.remaining()) + " bytes left)");
-    ByteReader r(children + pos + kChunkHeaderBytes, size_t(n), file, chunkWhere);
+    ChunkReader r(children + pos + kChunkHeaderBytes, size_t(n), file, chunkWhere);
     pos += kChunkHeaderBytes + size_t(n) + size_t(m);
     ++chunkIndex;
 
@@ -385,9 +351,9 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
       ++set.skippedChunks;
     }
   }
-  if (pendingSize) fail(file, "MAIN chunk", "the last SIZE chunk has no XYZI chunk");
+  if (pendingSize) failFile(file, "MAIN chunk", "the last SIZE chunk has no XYZI chunk");
   if (packModels >= 0 && size_t(packModels) != set.models.size())
-    fail(file, "PACK chunk",
+    failFile(file, "PACK chunk",
          "numModels " + std::to_string(packModels) + " but the file has " + std::to_string(set.models.size()) +
              " SIZE/XYZI pairs");
 
@@ -419,7 +385,7 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
     for (size_t c = 0; c < 256; ++c) set.paletteCounts[c] += modelCounts[inst.model][c];
     set.totalVoxels += model.voxels.size();
     if (set.totalVoxels > kVoxMaxPlacedVoxels)
-      fail(file, "scene graph", "places more than " + std::to_string(kVoxMaxPlacedVoxels) + " voxels");
+      failFile(file, "scene graph", "places more than " + std::to_string(kVoxMaxPlacedVoxels) + " voxels");
     if (!local.empty()) {
       tight.add({inst.offset.x + local.lo.x, inst.offset.y + local.lo.y, inst.offset.z + local.lo.z});
       tight.add({inst.offset.x + local.hi.x, inst.offset.y + local.hi.y, inst.offset.z + local.hi.z});
@@ -444,15 +410,15 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
 
 VoxModelSet loadVox(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "file", "cannot be opened");
+  if (!in) failFile(path, "file", "cannot be opened");
   in.seekg(0, std::ios::end);
   const std::streamoff end = in.tellg();
-  if (end < 0) fail(path, "file", "cannot be read");
-  if (end > kMaxFileBytes) fail(path, "file", "is larger than 2 GiB");
+  if (end < 0) failFile(path, "file", "cannot be read");
+  if (end > kMaxFileBytes) failFile(path, "file", "is larger than 2 GiB");
   std::vector<uint8_t> bytes(static_cast<size_t>(end));
   in.seekg(0, std::ios::beg);
   if (!bytes.empty() && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
-    fail(path, "file", "cannot be read");
+    failFile(path, "file", "cannot be read");
   return parseVox(bytes.data(), bytes.size(), path);
 }
 
@@ -479,43 +445,43 @@ VoxMaterialMap parseVoxMaterialMap(const std::string& text, const std::string& f
   try {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    fail(file, "mapping", std::string("not valid JSON: ") + e.what());
+    failFile(file, "mapping", std::string("not valid JSON: ") + e.what());
   }
-  if (!j.is_object()) fail(file, "mapping", "must be a JSON object");
+  if (!j.is_object()) failFile(file, "mapping", "must be a JSON object");
   auto paletteIndex = [&](const nlohmann::json& v, const std::string& what) {
     if (!v.is_number_integer() || v.get<int64_t>() < 1 || v.get<int64_t>() > 255)
-      fail(file, what, "palette index " + v.dump() + " is not an integer in [1, 255]");
+      failFile(file, what, "palette index " + v.dump() + " is not an integer in [1, 255]");
     return int(v.get<int64_t>());
   };
   auto material = [&](const nlohmann::json& v, const std::string& what, int lo) {
     if (!v.is_number_integer() || v.get<int64_t>() < lo || v.get<int64_t>() > 255)
-      fail(file, what, "material " + v.dump() + " is not an integer in [" + std::to_string(lo) + ", 255]");
+      failFile(file, what, "material " + v.dump() + " is not an integer in [" + std::to_string(lo) + ", 255]");
     return int(v.get<int64_t>());
   };
   VoxMaterialMap m;
   for (const auto& [key, value] : j.items()) {
     if (key == "water") {
-      if (!value.is_array() || value.size() != 2) fail(file, "water", "must be [first, last]");
+      if (!value.is_array() || value.size() != 2) failFile(file, "water", "must be [first, last]");
       m.waterFirst = paletteIndex(value[0], "water");
       m.waterLast = paletteIndex(value[1], "water");
-      if (m.waterLast < m.waterFirst) fail(file, "water", "range " + value.dump() + " is inverted");
+      if (m.waterLast < m.waterFirst) failFile(file, "water", "range " + value.dump() + " is inverted");
     } else if (key == "solids") {
       if (value == "per_index") m.solids = VoxMaterialMap::Solids::PerPaletteIndex;
       else if (value == "single") m.solids = VoxMaterialMap::Solids::Single;
-      else fail(file, "solids", value.dump() + " is neither \"per_index\" nor \"single\"");
+      else failFile(file, "solids", value.dump() + " is neither \"per_index\" nor \"single\"");
     } else if (key == "solid_material") {
       m.solidMaterial = uint8_t(material(value, "solid_material", kMaterialFirstSolid));
     } else if (key == "materials") {
-      if (!value.is_object()) fail(file, "materials", "must be an object {\"paletteIndex\": material}");
+      if (!value.is_object()) failFile(file, "materials", "must be an object {\"paletteIndex\": material}");
       for (const auto& [indexText, mat] : value.items()) {
         int index = 0;
         const auto [next, ec] = std::from_chars(indexText.data(), indexText.data() + indexText.size(), index);
         if (ec != std::errc() || next != indexText.data() + indexText.size() || index < 1 || index > 255)
-          fail(file, "materials", "key \"" + indexText + "\" is not a palette index in [1, 255]");
+          failFile(file, "materials", "key \"" + indexText + "\" is not a palette index in [1, 255]");
         m.overrides[size_t(index)] = int16_t(material(mat, "materials[\"" + indexText + "\"]", 0));
       }
     } else {
-      fail(file, "mapping", "unknown key \"" + key + "\" (expected water, solids, solid_material, materials)");
+      failFile(file, "mapping", "unknown key \"" + key + "\" (expected water, solids, solid_material, materials)");
     }
   }
   return m;
@@ -523,7 +489,7 @@ VoxMaterialMap parseVoxMaterialMap(const std::string& text, const std::string& f
 
 VoxMaterialMap loadVoxMaterialMap(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "file", "cannot be opened");
+  if (!in) failFile(path, "file", "cannot be opened");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   return parseVoxMaterialMap(text, path);
 }
