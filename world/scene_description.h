@@ -22,6 +22,15 @@ constexpr double kMinSize = 1e-3, kMaxSize = 1e4;        ///< primitive half ext
 constexpr double kMinDensity = 1e-3, kMaxDensity = 1e5;  ///< kg/m^3 (no zero-mass dynamic bodies)
 constexpr double kMinTimestep = 1.0 / 10000, kMaxTimestep = 1.0 / 10;  ///< seconds per frame
 constexpr double kMaxGravity = 1000;     ///< |gravity component|, m/s^2
+constexpr int kMaxSubsteps = 64, kMaxSolverIterations = 256, kMaxRelaxIterations = 64;
+constexpr int kMaxManifoldSize = 64, kMaxApproximationDepth = 7;
+constexpr double kMinScale = 0.001, kMaxScale = 64;      ///< generator scale
+constexpr int kMaxTilesPerAxis = 1000;
+constexpr double kMaxTileGap = 1e5;
+constexpr double kMinVoxelSize = 1e-3, kMaxVoxelSize = 1e3;
+constexpr double kMinWaterDensity = 1, kMaxWaterDensity = 1e5;
+constexpr uint32_t kMaxSpawnCount = 1'000'000;
+constexpr double kMaxRayLength = 1e7;
 }  // namespace scene_limits
 
 /// How a body moves.

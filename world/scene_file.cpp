@@ -165,11 +165,11 @@ GridDescription parseGrid(const Field& f, const std::string& sceneSource) {
   if (f.has("tiles")) {
     const Field t = f.at("tiles");
     if (t.arraySize(2) != 2) t.fail("[tiles along x, tiles along y]");
-    g.tilesX = int(t.index(0).integer(1, 1000));
-    g.tilesY = int(t.index(1).integer(1, 1000));
+    g.tilesX = int(t.index(0).integer(1, scene_limits::kMaxTilesPerAxis));
+    g.tilesY = int(t.index(1).integer(1, scene_limits::kMaxTilesPerAxis));
     if (f.has("bricks")) t.failMessage("tiles apply to a generator or a file, not to explicit bricks");
   }
-  if (f.has("tile_gap")) g.tileGap = float(f.at("tile_gap").number(0, 1e5));
+  if (f.has("tile_gap")) g.tileGap = float(f.at("tile_gap").number(0, scene_limits::kMaxTileGap));
   if (f.has("file")) {
     g.file = contentPath(f.at("file"), sceneSource, ".brs");
   } else if (f.has("generator")) {
@@ -181,7 +181,7 @@ GridDescription parseGrid(const Field& f, const std::string& sceneSource) {
       for (const auto& n : names) list += (list.empty() ? "\"" : ", \"") + n + "\"";
       gen.fail("one of " + list);
     }
-    if (f.has("scale")) g.scale = float(f.at("scale").number(0.001, 64));
+    if (f.has("scale")) g.scale = float(f.at("scale").number(scene_limits::kMinScale, scene_limits::kMaxScale));
     if (f.has("seed")) g.seed = f.at("seed").seed();
   } else {
     const Field bricks = f.at("bricks");
@@ -209,7 +209,7 @@ SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescriptio
           : shape == "box"    ? SpawnerDescription::Shape::Box
           : shape == "capsule" ? SpawnerDescription::Shape::Capsule
                                : SpawnerDescription::Shape::Grid;
-  s.count = uint32_t(f.at("count").integer(1, 1'000'000));
+  s.count = uint32_t(f.at("count").integer(1, scene_limits::kMaxSpawnCount));
   if (s.shape == SpawnerDescription::Shape::Grid) {
     const Field g = f.at("grid");
     s.grid = g.string();
@@ -238,15 +238,15 @@ SceneSettings parseSettings(const Field& f) {
   SceneSettings s;
   if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-scene_limits::kMaxGravity, scene_limits::kMaxGravity);
   if (f.has("timestep")) s.timestep = f.at("timestep").number(scene_limits::kMinTimestep, scene_limits::kMaxTimestep);
-  if (f.has("substeps")) s.substeps = int(f.at("substeps").integer(1, 64));
-  if (f.has("solver_iterations")) s.solverIterations = int(f.at("solver_iterations").integer(1, 256));
+  if (f.has("substeps")) s.substeps = int(f.at("substeps").integer(1, scene_limits::kMaxSubsteps));
+  if (f.has("solver_iterations")) s.solverIterations = int(f.at("solver_iterations").integer(1, scene_limits::kMaxSolverIterations));
   if (f.has("frames")) s.frames = uint32_t(f.at("frames").integer(1, 10'000'000));
   if (f.has("lod_fraction")) s.lodFraction = float(f.at("lod_fraction").number(0, 1));
-  if (f.has("approximation_depth")) s.approximationDepth = int(f.at("approximation_depth").integer(0, 7));
+  if (f.has("approximation_depth")) s.approximationDepth = int(f.at("approximation_depth").integer(0, scene_limits::kMaxApproximationDepth));
   if (f.has("sleeping")) s.sleeping = f.at("sleeping").boolean();
   if (f.has("shock_propagation")) s.shockPropagation = f.at("shock_propagation").boolean();
-  if (f.has("relax_iterations")) s.relaxIterations = int(f.at("relax_iterations").integer(0, 64));
-  if (f.has("manifold_size")) s.manifoldSize = int(f.at("manifold_size").integer(1, 64));
+  if (f.has("relax_iterations")) s.relaxIterations = int(f.at("relax_iterations").integer(0, scene_limits::kMaxRelaxIterations));
+  if (f.has("manifold_size")) s.manifoldSize = int(f.at("manifold_size").integer(1, scene_limits::kMaxManifoldSize));
   if (f.has("reuse_translation")) s.reuseTranslation = f.at("reuse_translation").number(0, 1);
   if (f.has("reuse_rotation")) s.reuseRotation = float(f.at("reuse_rotation").number(0, 1));
   return s;
@@ -257,7 +257,7 @@ TerrainDescription parseTerrain(const Field& f, const std::string& sceneSource) 
   TerrainDescription t;
   t.name = f.at("name").string();
   t.file = contentPath(f.at("file"), sceneSource, ".vox");
-  if (f.has("voxel_size")) t.voxelSize = float(f.at("voxel_size").number(1e-3, 1e3));
+  if (f.has("voxel_size")) t.voxelSize = float(f.at("voxel_size").number(scene_limits::kMinVoxelSize, scene_limits::kMaxVoxelSize));
   if (f.has("position")) t.position = f.at("position").vec3(-kMaxCoord, kMaxCoord);
   if (f.has("water")) {
     const Field w = f.at("water");
@@ -266,7 +266,7 @@ TerrainDescription parseTerrain(const Field& f, const std::string& sceneSource) 
     t.waterLast = int(w.index(1).integer(1, 255));
     if (t.waterFirst > t.waterLast) w.failMessage("first palette index is greater than the last");
   }
-  if (f.has("water_density")) t.waterDensity = float(f.at("water_density").number(1, 1e5));
+  if (f.has("water_density")) t.waterDensity = float(f.at("water_density").number(scene_limits::kMinWaterDensity, scene_limits::kMaxWaterDensity));
   return t;
 }
 
@@ -274,7 +274,7 @@ RayLoadDescription parseRays(const Field& f) {
   f.allowOnly({"count", "length", "seed"});
   RayLoadDescription r;
   r.count = uint32_t(f.at("count").integer(0, 10'000'000));
-  if (f.has("length")) r.length = float(f.at("length").number(0, 1e7));
+  if (f.has("length")) r.length = float(f.at("length").number(0, scene_limits::kMaxRayLength));
   if (f.has("seed")) r.seed = f.at("seed").seed();
   return r;
 }

@@ -52,22 +52,22 @@ void validateScene(const SceneDescription& scene) {
   const SceneSettings& s = scene.settings;
   c.vector("settings.gravity", s.gravity, -kMaxGravity, kMaxGravity);
   c.number("settings.timestep", s.timestep, kMinTimestep, kMaxTimestep);
-  c.number("settings.substeps", s.substeps, 1, 64);
-  c.number("settings.solver_iterations", s.solverIterations, 1, 256);
+  c.number("settings.substeps", s.substeps, 1, kMaxSubsteps);
+  c.number("settings.solver_iterations", s.solverIterations, 1, kMaxSolverIterations);
   c.number("settings.lod_fraction", s.lodFraction, 0, 1);
-  c.number("settings.approximation_depth", s.approximationDepth, 0, 7);
-  c.number("settings.relax_iterations", s.relaxIterations, 0, 64);
-  c.number("settings.manifold_size", s.manifoldSize, 1, 64);
+  c.number("settings.approximation_depth", s.approximationDepth, 0, kMaxApproximationDepth);
+  c.number("settings.relax_iterations", s.relaxIterations, 0, kMaxRelaxIterations);
+  c.number("settings.manifold_size", s.manifoldSize, 1, kMaxManifoldSize);
   c.number("settings.reuse_translation", s.reuseTranslation, 0, 1);
   c.number("settings.reuse_rotation", s.reuseRotation, 0, 1);
   for (size_t i = 0; i < scene.grids.size(); ++i) {
     const GridDescription& g = scene.grids[i];
     const std::string f = "grids[" + std::to_string(i) + "]";
     if (g.name.empty()) c.message(f + ".name", "expected a non-empty name");
-    c.number(f + ".scale", g.scale, 0.001, 64);
-    c.number(f + ".tiles[0]", g.tilesX, 1, 1000);
-    c.number(f + ".tiles[1]", g.tilesY, 1, 1000);
-    c.number(f + ".tile_gap", g.tileGap, 0, 1e5);
+    c.number(f + ".scale", g.scale, kMinScale, kMaxScale);
+    c.number(f + ".tiles[0]", g.tilesX, 1, kMaxTilesPerAxis);
+    c.number(f + ".tiles[1]", g.tilesY, 1, kMaxTilesPerAxis);
+    c.number(f + ".tile_gap", g.tileGap, 0, kMaxTileGap);
     c.vector(f + ".position", g.position, -kMaxCoordinate, kMaxCoordinate);
     c.unitQuaternion(f + ".rotation", g.rotation);
     c.vector(f + ".linear_velocity", g.kinematic.linearVelocity, -kMaxSpeed, kMaxSpeed);
@@ -77,7 +77,7 @@ void validateScene(const SceneDescription& scene) {
   for (size_t i = 0; i < scene.spawners.size(); ++i) {
     const SpawnerDescription& sp = scene.spawners[i];
     const std::string f = "spawners[" + std::to_string(i) + "]";
-    c.number(f + ".count", sp.count, 0, 1'000'000);
+    c.number(f + ".count", sp.count, 0, kMaxSpawnCount);
     c.vector(f + ".half_extents", sp.halfExtents, kMinSize, kMaxSize);
     c.number(f + ".radius", sp.radius, kMinSize, kMaxSize);
     c.number(f + ".half_height", sp.halfHeight, 0, kMaxSize);
@@ -96,12 +96,12 @@ void validateScene(const SceneDescription& scene) {
   for (size_t i = 0; i < scene.terrains.size(); ++i) {
     const TerrainDescription& t = scene.terrains[i];
     const std::string f = "terrains[" + std::to_string(i) + "]";
-    c.number(f + ".voxel_size", t.voxelSize, 1e-3, 1e3);
+    c.number(f + ".voxel_size", t.voxelSize, kMinVoxelSize, kMaxVoxelSize);
     c.vector(f + ".position", t.position, -kMaxCoordinate, kMaxCoordinate);
-    c.number(f + ".water_density", t.waterDensity, 1, 1e5);
+    c.number(f + ".water_density", t.waterDensity, kMinWaterDensity, kMaxWaterDensity);
     if (t.waterFirst >= 0 && (t.waterFirst > t.waterLast || t.waterLast > 255)) c.message(f + ".water", "expected 1 <= first <= last <= 255");
   }
-  c.number("rays.length", scene.rays.length, 0, 1e7);
+  c.number("rays.length", scene.rays.length, 0, kMaxRayLength);
 }
 
 }  // namespace bw
