@@ -574,12 +574,6 @@ void World::buildIslands() {
   islandContacts_.resize(contacts_.size());
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
   for (uint32_t k = 0; k < contacts_.size(); ++k) islandContacts_[fill[rootIndex[islandOfContact(contacts_[k])]]++] = k;
-  // note: the contacts are moved into island order once, so every solver iteration streams
-  // through memory instead of jumping between islands (the solve order is unchanged).
-  orderedContacts_.resize(contacts_.size());
-  for (uint32_t k = 0; k < contacts_.size(); ++k) orderedContacts_[k] = contacts_[islandContacts_[k]];
-  std::swap(contacts_, orderedContacts_);
-  for (uint32_t k = 0; k < contacts_.size(); ++k) islandContacts_[k] = k;
 }
 
 // Applies impulse `lambda` along direction d (0 normal, 1 and 2 tangents) to the contact's
@@ -776,7 +770,7 @@ void World::solve(bool relax) {
   // on their size, so the result does not depend on the thread count.
   const uint32_t islands = uint32_t(islandStart_.size() - 1);
   smallIslands_.clear();
-  bodyColours_.assign(bodies_.size(), 0);
+  bodyColours_.resize(bodies_.size(), 0);  // colourIsland() leaves it all zero again
   if (!relax) stats_.largestIsland = 0;
   for (uint32_t i = 0; i < islands; ++i) {
     const uint32_t size = islandStart_[i + 1] - islandStart_[i];

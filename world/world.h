@@ -180,7 +180,7 @@ class World {
   std::vector<ContactScratch> scratch_;             // one per pair slot
   std::vector<uint8_t> pairFlipped_;                // slot's contacts have normal from pair.a to pair.b
   std::vector<ContactStats> pairStats_;
-  std::vector<SolverContact> contacts_, orderedContacts_;
+  std::vector<SolverContact> contacts_;
   struct SolverBody {
     Vec3f v;            // 12 linear velocity
     float invMass;      // 4
