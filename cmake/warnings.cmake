@@ -13,6 +13,11 @@ elseif(BW_SANITIZE STREQUAL "thread")
 elseif(NOT BW_SANITIZE STREQUAL "")
   message(FATAL_ERROR "BW_SANITIZE must be empty, address or thread (got '${BW_SANITIZE}')")
 endif()
+# BW_ASSERT (collision/core/assert.h) is checked in debug and under the sanitizers, never in the
+# release build the figures come from.
+if(CMAKE_BUILD_TYPE STREQUAL "Debug" OR NOT BW_SANITIZE STREQUAL "")
+  target_compile_definitions(bw_build_options INTERFACE BW_ENABLE_ASSERTS)
+endif()
 add_library(bw::build_options ALIAS bw_build_options)
 
 # bw_add_module(NAME SOURCES... DEPS ...): one static library target bw::NAME per module.

@@ -4,9 +4,8 @@
 #include <atomic>
 #include <fstream>
 #include <map>
-#include <stdexcept>
-
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 namespace bw {
 

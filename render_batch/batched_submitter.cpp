@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 

@@ -2,9 +2,8 @@
 /// Lock-free command queue on oneTBB's concurrent_queue: the "fix" of putting a better queue
 /// under per-object submission. It removes the lock but still does one queue operation (a
 /// page allocation and a 192-byte command copy) per moved object, which batching removes.
-#include <oneapi/tbb/concurrent_queue.h>
-
 #include <memory>
+#include <oneapi/tbb/concurrent_queue.h>
 
 #include "render_batch/command_queue.h"
 

@@ -3,7 +3,8 @@
 #include <cstring>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/hash.h"
 
 namespace bw {
 
@@ -109,11 +110,8 @@ bool RenderScene::identicalTo(const RenderScene& other) const {
 }
 
 uint64_t RenderScene::stateHash() const {
-  uint64_t h = 0xcbf29ce484222325ull;
-  forEachStateArray([&h](const void* p, size_t n) {
-    const unsigned char* b = static_cast<const unsigned char*>(p);
-    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
-  });
+  uint64_t h = 0;
+  forEachStateArray([&h](const void* p, size_t n) { h = hashBytes(h, p, n); });
   return h;
 }
 

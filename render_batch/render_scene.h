@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "collision/aabb.h"
-#include "collision/math_types.h"
+#include "collision/core/aabb.h"
+#include "collision/core/math_types.h"
 #include "transforms/transform_records.h"
 
 namespace bw {

@@ -4,7 +4,7 @@
 ///
 /// note: every path calls these same inline functions (and the build uses -ffp-contract=off),
 /// so all three produce bit-identical records; that is what the differential tests rely on.
-#include "collision/aabb.h"
+#include "collision/core/aabb.h"
 #include "transforms/transform_records.h"
 
 namespace bw {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 
@@ -14,7 +14,7 @@ uint32_t AttachmentStore::add(uint32_t body, uint32_t parent, const Vec3f& t, co
   if (size() == UINT32_MAX - 1) throw CapacityExceeded(std::string(context) + ": attachment count exceeds 2^32 - 2");
   if (body == UINT32_MAX) throw InvalidInput(std::string(context) + ": body index is UINT32_MAX");
   uint8_t depth = 0;
-  if (parent != kNoParentAttachment) {
+  if (parent != kInvalidIndex) {
     if (parent >= size())
       throw InvalidInput(std::string(context) + ": parent attachment " + std::to_string(parent) +
                          " does not exist (" + std::to_string(size()) + " attachments)");

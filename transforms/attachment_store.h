@@ -2,7 +2,7 @@
 /// SoA store of attachments: render primitives and lights riding on bodies with local offsets.
 ///
 ///   AttachmentStore store;
-///   uint32_t hull  = store.addPrimitive(body, kNoParentAttachment, offset, rot, localBox);
+///   uint32_t hull  = store.addPrimitive(body, kInvalidIndex, offset, rot, localBox);
 ///   uint32_t lamp  = store.addLight(body, hull, lampOffset, Quatf::Identity(), 12.f);  // rides on hull
 ///
 /// Layout: one array per field, indexed by attachment id (a stable 32-bit handle). Hot fields
@@ -18,13 +18,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "collision/aabb.h"
-#include "collision/math_types.h"
+#include "collision/core/aabb.h"
+#include "collision/core/ids.h"
+#include "collision/core/math_types.h"
 
 namespace bw {
 
 /// Parent value for an attachment that rides directly on its body.
-inline constexpr uint32_t kNoParentAttachment = UINT32_MAX;
 /// Deepest hierarchy allowed (a body's attachment chain is short in practice: hull -> lamp).
 inline constexpr uint32_t kMaxAttachmentDepth = 8;
 
@@ -34,7 +34,7 @@ enum class AttachmentKind : uint8_t { Primitive = 0, Light = 1 };
 /// Raw column pointers the transform update reads and writes (valid until the next edit).
 struct AttachmentColumns {
   const uint32_t* body;            ///< body each attachment (chain) rides on
-  const uint32_t* parent;          ///< parent attachment or kNoParentAttachment
+  const uint32_t* parent;          ///< parent attachment or kInvalidIndex
   const AttachmentKind* kind;      ///< primitive or light
   const uint32_t* renderId;        ///< proxy id or light id
   const Vec3f* localTranslation;   ///< offset in the parent's frame
@@ -78,7 +78,7 @@ class AttachmentStore {
   uint32_t renderId(uint32_t id) const { return renderId_[id]; }
   /// Body the attachment's chain rides on.
   uint32_t body(uint32_t id) const { return body_[id]; }
-  /// Parent attachment, or kNoParentAttachment.
+  /// Parent attachment, or kInvalidIndex.
   uint32_t parent(uint32_t id) const { return parent_[id]; }
   /// Hierarchy level (0 = rides directly on the body).
   uint32_t depth(uint32_t id) const { return depth_[id]; }

@@ -5,18 +5,11 @@
 #include <random>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/hash.h"
 
 namespace bw {
 namespace {
-
-/// splitmix64 finaliser: a counter-based hash, so motion is a pure function of (seed, frame, body).
-uint64_t mix(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
 
 /// Uniform double in [0, 1) from 53 random bits (portable, unlike std distributions).
 double unit(uint64_t bits) { return static_cast<double>(bits >> 11) * 0x1.0p-53; }
@@ -39,7 +32,7 @@ Vec3f randomVec(std::mt19937_64& rng, double lo, double hi) {
 }  // namespace
 
 BodyMotion::BodyMotion(uint32_t count, uint64_t seed, double extent, const Vec3d& offset) : seed_(seed) {
-  std::mt19937_64 rng(mix(seed ^ 0x626f646965730000ull));
+  std::mt19937_64 rng(splitmix64(seed ^ 0x626f646965730000ull));
   position_.reserve(count);
   rotation_.reserve(count);
   velocity_.reserve(count);
@@ -59,9 +52,9 @@ BodyMotion::BodyMotion(uint32_t count, uint64_t seed, double extent, const Vec3d
 
 void BodyMotion::step(uint64_t frame, float movingFraction) {
   uint32_t movedCount = 0;
-  const uint64_t frameKey = mix(seed_ ^ mix(frame));
+  const uint64_t frameKey = splitmix64(seed_ ^ splitmix64(frame));
   for (uint32_t i = 0; i < count(); ++i) {
-    const bool move = unit(mix(frameKey + i)) < movingFraction;
+    const bool move = unit(splitmix64(frameKey + i)) < movingFraction;
     moved_[i] = move ? 1 : 0;
     if (!move) continue;
     ++movedCount;
@@ -86,7 +79,7 @@ AttachmentWorkload makeAttachmentWorkload(const AttachmentWorkloadDesc& desc) {
   requireInRange(desc.worldExtent, 0, 1e12, context, "worldExtent");
   requireFinite(desc.worldOffset, context, "worldOffset");
 
-  std::mt19937_64 rng(mix(desc.seed));
+  std::mt19937_64 rng(splitmix64(desc.seed));
   AttachmentStore store;
   store.reserve(desc.attachments);
   std::vector<uint32_t> bodyAttachments;  // attachments of the body being built
@@ -97,11 +90,11 @@ AttachmentWorkload makeAttachmentWorkload(const AttachmentWorkloadDesc& desc) {
     // Every body carries a root primitive (its hull), then 0..4 more attachments.
     const Vec3f half = randomVec(rng, 0.25, 4.0);
     bodyAttachments.push_back(
-        store.addPrimitive(body, kNoParentAttachment, randomVec(rng, -0.5, 0.5), randomRotation(rng),
+        store.addPrimitive(body, kInvalidIndex, randomVec(rng, -0.5, 0.5), randomRotation(rng),
                            Aabb::fromCenterHalf(randomVec(rng, -0.2, 0.2), half)));
     const uint32_t extra = static_cast<uint32_t>(rng() % 5);
     for (uint32_t k = 0; k < extra && store.size() < desc.attachments; ++k) {
-      uint32_t parent = kNoParentAttachment;
+      uint32_t parent = kInvalidIndex;
       if (unit(rng()) < desc.childFraction) {
         const uint32_t candidate = bodyAttachments[rng() % bodyAttachments.size()];
         if (store.depth(candidate) + 1 < desc.maxDepth) parent = candidate;

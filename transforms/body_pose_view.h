@@ -6,7 +6,7 @@
 /// for the duration of one update call.
 #include <cstdint>
 
-#include "collision/math_types.h"
+#include "collision/core/math_types.h"
 
 namespace bw {
 

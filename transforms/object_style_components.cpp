@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 #include "transforms/attachment_math.h"
 
 namespace bw {
@@ -50,7 +50,7 @@ ObjectStyleScene::ObjectStyleScene(const AttachmentStore& store) : bodiesReferen
   components_.reserve(store.size());
   for (uint32_t id = 0; id < store.size(); ++id) {
     SceneComponent* parent =
-        store.parent(id) == kNoParentAttachment ? nullptr : components_[store.parent(id)].get();
+        store.parent(id) == kInvalidIndex ? nullptr : components_[store.parent(id)].get();
     if (store.kind(id) == AttachmentKind::Primitive)
       components_.push_back(std::make_unique<PrimitiveComponent>(store.body(id), parent, store.localTranslation(id),
                                                                  store.localRotation(id), store.localBounds(id),

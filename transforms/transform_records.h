@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <type_traits>
 
-#include "collision/aabb.h"
-#include "collision/math_types.h"
+#include "collision/core/aabb.h"
+#include "collision/core/math_types.h"
 
 namespace bw {
 

@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 #include "transforms/attachment_math.h"
 
 namespace bw {
@@ -27,14 +27,14 @@ void TransformUpdate::runRange(uint32_t begin, uint32_t end) const {
     const uint32_t body = c.body[id];
     // note: a parent is one level up, finished before this level started, so reading its
     // moved flag and pose here is race-free.
-    const bool parentMoved = parent == kNoParentAttachment ? bodies_.moved[body] != 0 : c.moved[parent] != 0;
+    const bool parentMoved = parent == kInvalidIndex ? bodies_.moved[body] != 0 : c.moved[parent] != 0;
     const bool moved = parentMoved || c.localDirty[id] != 0;
     c.moved[id] = moved ? 1 : 0;
     if (!moved) continue;
     c.localDirty[id] = 0;
     const Vec3d previousTranslation = c.worldTranslation[id];
     const Quatf previousRotation = c.worldRotation[id];
-    if (parent == kNoParentAttachment)
+    if (parent == kInvalidIndex)
       composeAttachmentPose(bodies_.position[body], bodies_.rotation[body], c.localTranslation[id],
                             c.localRotation[id], c.worldTranslation[id], c.worldRotation[id]);
     else

@@ -1,6 +1,6 @@
 #include "world/body_store.h"
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 

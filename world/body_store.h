@@ -8,8 +8,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "collision/query_shape.h"
-#include "collision/rigid_transform.h"
+#include "collision/bricks/query_shape.h"
+#include "collision/core/ids.h"
+#include "collision/core/rigid_transform.h"
 #include "world/scene_description.h"
 
 namespace bw {
@@ -18,12 +19,10 @@ namespace bw {
 /// world's grids and terrains).
 struct BodyShape {
   QueryShape primitive;             ///< used when neither grid nor terrain is set
-  uint32_t grid = kNone;
-  uint32_t terrain = kNone;
-  static constexpr uint32_t kNone = 0xFFFFFFFFu;
-  static constexpr uint32_t kNoGrid = kNone;
-  bool isGrid() const { return grid != kNone; }
-  bool isTerrain() const { return terrain != kNone; }
+  uint32_t grid = kInvalidIndex;
+  uint32_t terrain = kInvalidIndex;
+  bool isGrid() const { return grid != kInvalidIndex; }
+  bool isTerrain() const { return terrain != kInvalidIndex; }
 };
 
 struct BodyStore {

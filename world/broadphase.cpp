@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 

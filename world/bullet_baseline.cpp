@@ -1,7 +1,6 @@
 #include "world/bullet_baseline.h"
 
 #include <btBulletDynamicsCommon.h>
-
 #include <chrono>
 #include <limits>
 #include <vector>

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "collision/brick.h"
-#include "collision/math_types.h"
+#include "collision/bricks/brick.h"
+#include "collision/core/math_types.h"
 
 namespace bw {
 

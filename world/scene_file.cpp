@@ -8,8 +8,8 @@
 #include <set>
 #include <sstream>
 
-#include "collision/build_generators.h"
-#include "collision/input_validation.h"
+#include "collision/content/build_generators.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 

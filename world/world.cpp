@@ -7,13 +7,14 @@
 #include <cstring>
 #include <limits>
 
-#include "collision/brs_reader.h"
-#include "collision/build_generators.h"
-#include "collision/build_tiling.h"
-#include "collision/input_validation.h"
-#include "collision/seeded_random.h"
+#include "collision/content/brs_reader.h"
+#include "collision/content/build_generators.h"
+#include "collision/content/build_tiling.h"
+#include "collision/content/vox_reader.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/hash.h"
+#include "collision/core/seeded_random.h"
 #include "collision/terrain/terrain_contacts.h"
-#include "collision/terrain/vox_reader.h"
 #include "world/scene_file.h"
 #include "world/scene_validation.h"
 
@@ -68,19 +69,6 @@ void primitiveMass(const QueryShape& s, float density, float& invMass, Vec3f& in
   }
   invMass = 1.f / m;
   invInertia = I.cwiseInverse();
-}
-
-uint64_t mixHash(uint64_t h, uint64_t v) {
-  h ^= v + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
-  h *= 0xBF58476D1CE4E5B9ull;
-  return h ^ (h >> 31);
-}
-
-template <class T>
-uint64_t bitsOf(const T& v) {
-  uint64_t out = 0;
-  std::memcpy(&out, &v, std::min(sizeof(T), sizeof(out)));
-  return out;
 }
 
 }  // namespace
@@ -355,35 +343,23 @@ void World::terrainPairs(float dt) {
     if (!canCollide(a, b) || (!active(a) && !active(b))) continue;
     const uint32_t body = terrainA ? b : a, terrainBody = terrainA ? a : b;
     Terrain& terrain = *terrains_[bodies_.shape[terrainBody].terrain];
-    const RigidTransform pose = bodies_.shapePose(body);
-    TerrainContactShape shape;
-    const BodyShape& bs = bodies_.shape[body];
-    if (bs.isGrid()) {
+    RigidTransform pose = bodies_.shapePose(body);
+    QueryShape shape = bodies_.shape[body].primitive;
+    if (bodies_.shape[body].isGrid()) {
       // A grid meets terrain through its convex approximation (as it meets other grids).
-      const ConvexApproximation& hull = grids_[bs.grid]->convexApproximation(scene_.settings.approximationDepth);
-      const Vec3d centre = pose.pointToWorld(hull.shapeCenter());
-      shape = hull.isBox ? TerrainContactShape::box(centre, pose.rotation, hull.bounds.halfExtent())
-                         : TerrainContactShape::convexHull(centre, pose.rotation, hull.centered.data(), uint32_t(hull.centered.size()));
-    } else if (bs.primitive.kind == QueryShape::Kind::Sphere) {
-      shape = TerrainContactShape::sphere(pose.translation, bs.primitive.radius);
-    } else if (bs.primitive.kind == QueryShape::Kind::Capsule) {
-      // Our capsules run along local z, the terrain's along local y: turn y onto z.
-      const Quatf yToZ(Eigen::AngleAxisf(1.5707963f, Vec3f::UnitX()));
-      shape = TerrainContactShape::capsule(pose.translation, pose.rotation * yToZ, bs.primitive.halfHeight, bs.primitive.radius);
-    } else if (bs.primitive.kind == QueryShape::Kind::Box) {
-      shape = TerrainContactShape::box(pose.translation, pose.rotation, bs.primitive.halfExtents);
-    } else {
-      shape = TerrainContactShape::convexHull(pose.translation, pose.rotation, bs.primitive.points, bs.primitive.pointCount);
+      const ConvexApproximation& hull = grids_[bodies_.shape[body].grid]->convexApproximation(scene_.settings.approximationDepth);
+      pose.translation = pose.pointToWorld(hull.shapeCenter());
+      shape = hull.shape();
     }
     std::vector<Contact>& out = pairContacts_[k];
     out.clear();
     const float margin = 0.01f + bodies_.linearVelocity[body].norm() * dt;
-    terrainContacts(terrain, shape, margin, out);
+    terrainContacts(terrain, shape, pose, margin, out);
     pairFlipped_[k] = body == b;  // normals point from the terrain towards the body
     stats_.terrainContacts += uint32_t(out.size());
 
     WaterContact water;
-    if (bodies_.motion[body] != MotionType::Dynamic || !terrainWaterContact(terrain, shape, water)) continue;
+    if (bodies_.motion[body] != MotionType::Dynamic || !terrainWaterContact(terrain, shape, pose, water)) continue;
     // Archimedes: the displaced water's weight, applied at the centre of buoyancy, as an
     // impulse this substep; then drag in proportion to how deep the body sits.
     const float impulse = float(waterDensity_[bodies_.shape[terrainBody].terrain] * water.submergedVolume) * dt;
@@ -554,14 +530,14 @@ void World::buildIslands() {
   }
   // Contacts grouped by the island of their dynamic body, islands ordered by root id (CSR).
   std::vector<uint32_t>& start = islandStart_;
-  std::vector<uint32_t> rootIndex(n, 0xFFFFFFFFu);
+  std::vector<uint32_t> rootIndex(n, kInvalidIndex);
   std::vector<uint32_t> roots;
   auto islandOfContact = [&](const SolverContact& c) {
     return find(bodies_.motion[c.a] == MotionType::Dynamic ? c.a : c.b);
   };
   for (const SolverContact& c : contacts_) {
     const uint32_t r = islandOfContact(c);
-    if (rootIndex[r] == 0xFFFFFFFFu) {
+    if (rootIndex[r] == kInvalidIndex) {
       rootIndex[r] = 0;
       roots.push_back(r);
     }
@@ -980,9 +956,9 @@ void World::step() {
 uint64_t World::stateHash() const {
   uint64_t h = 0;
   for (uint32_t i = 0; i < bodies_.size(); ++i) {
-    for (int k = 0; k < 3; ++k) h = mixHash(h, bitsOf(bodies_.position[i][k]));
-    for (int k = 0; k < 4; ++k) h = mixHash(h, bitsOf(bodies_.rotation[i].coeffs()[k]));
-    for (int k = 0; k < 3; ++k) h = mixHash(mixHash(h, bitsOf(bodies_.linearVelocity[i][k])), bitsOf(bodies_.angularVelocity[i][k]));
+    for (int k = 0; k < 3; ++k) h = hashCombine(h, bitsOf(bodies_.position[i][k]));
+    for (int k = 0; k < 4; ++k) h = hashCombine(h, bitsOf(bodies_.rotation[i].coeffs()[k]));
+    for (int k = 0; k < 3; ++k) h = hashCombine(hashCombine(h, bitsOf(bodies_.linearVelocity[i][k])), bitsOf(bodies_.angularVelocity[i][k]));
   }
   return h;
 }

@@ -20,7 +20,7 @@
 #include <memory>
 #include <vector>
 
-#include "collision/brick_grid.h"
+#include "collision/bricks/brick_grid.h"
 #include "collision/terrain/terrain.h"
 #include "jobs/job_system.h"
 #include "jobs/profiler.h"

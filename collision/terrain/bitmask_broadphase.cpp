@@ -38,7 +38,7 @@ BitmaskBroadphase::BitmaskBroadphase(const Int3& chunkGrid, const Int3& sizeInVo
 void BitmaskBroadphase::setEntry(const Int3& c, ChunkMaskKind kind, const ChunkBitmask& bits) {
   const uint64_t key = chunkKey(c);
   const uint32_t old = entries_.find(key);
-  const bool hadMask = old != ChunkKeyMap::kNotFound && old != kTagAllSolid && old != kTagAllWater;
+  const bool hadMask = old != kInvalidIndex && old != kTagAllSolid && old != kTagAllWater;
   switch (kind) {
     case ChunkMaskKind::Empty:
       if (hadMask) masks_.free(old);
@@ -132,7 +132,7 @@ TerrainOverlap BitmaskBroadphase::overlapRange(const VoxelRange& r) const {
     for (int cz = r.lo.z >> kChunkShift; cz <= r.hi.z >> kChunkShift; ++cz) {
       for (int cx = r.lo.x >> kChunkShift; cx <= r.hi.x >> kChunkShift; ++cx) {
         const uint32_t e = entries_.find(chunkKey({cx, cy, cz}));
-        if (e == ChunkKeyMap::kNotFound) continue;
+        if (e == kInvalidIndex) continue;
         const Int3 lo{std::max(r.lo.x - cx * kChunkSize, 0), std::max(r.lo.y - cy * kChunkSize, 0),
                       std::max(r.lo.z - cz * kChunkSize, 0)};
         const Int3 hi{std::min(r.hi.x - cx * kChunkSize, kChunkSize - 1), std::min(r.hi.y - cy * kChunkSize, kChunkSize - 1),
@@ -156,7 +156,7 @@ TerrainOverlap BitmaskBroadphase::overlap(const Aabb& localBox, float voxelSize)
 
 ChunkMaskKind BitmaskBroadphase::kind(const Int3& c) const {
   const uint32_t e = entries_.find(chunkKey(c));
-  if (e == ChunkKeyMap::kNotFound) return ChunkMaskKind::Empty;
+  if (e == kInvalidIndex) return ChunkMaskKind::Empty;
   if (e == kTagAllSolid) return ChunkMaskKind::AllSolid;
   if (e == kTagAllWater) return ChunkMaskKind::AllWater;
   return ChunkMaskKind::Masked;
@@ -164,7 +164,7 @@ ChunkMaskKind BitmaskBroadphase::kind(const Int3& c) const {
 
 const ChunkBitmask* BitmaskBroadphase::masks(const Int3& c) const {
   const uint32_t e = entries_.find(chunkKey(c));
-  if (e == ChunkKeyMap::kNotFound || e == kTagAllSolid || e == kTagAllWater) return nullptr;
+  if (e == kInvalidIndex || e == kTagAllSolid || e == kTagAllWater) return nullptr;
   return &masks_[e];
 }
 

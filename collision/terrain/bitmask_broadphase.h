@@ -14,10 +14,10 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "collision/aabb.h"
+#include "collision/core/aabb.h"
+#include "collision/core/virtual_pool.h"
 #include "collision/terrain/chunk_bitmask.h"
 #include "collision/terrain/chunk_key_map.h"
-#include "collision/virtual_pool.h"
 
 namespace bw {
 
@@ -98,7 +98,7 @@ void BitmaskBroadphase::forEachTouchedChunk(const VoxelRange& r, F&& f) const {
     for (int cz = r.lo.z >> kChunkShift; cz <= r.hi.z >> kChunkShift; ++cz) {
       for (int cx = r.lo.x >> kChunkShift; cx <= r.hi.x >> kChunkShift; ++cx) {
         const uint32_t e = entries_.find(chunkKey({cx, cy, cz}));
-        if (e == ChunkKeyMap::kNotFound) continue;
+        if (e == kInvalidIndex) continue;
         const Int3 base{cx * kChunkSize, cy * kChunkSize, cz * kChunkSize};
         const Int3 lo{std::max(r.lo.x - base.x, 0), std::max(r.lo.y - base.y, 0), std::max(r.lo.z - base.z, 0)};
         const Int3 hi{std::min(r.hi.x - base.x, kChunkSize - 1), std::min(r.hi.y - base.y, kChunkSize - 1),

@@ -11,20 +11,20 @@ ChunkCache::ChunkCache(size_t budgetBytes) : budget_(budgetBytes) {}
 
 void ChunkCache::unlink(uint32_t e) {
   Entry& x = entries_[e];
-  if (x.prev != kNone) entries_[x.prev].next = x.next;
+  if (x.prev != kInvalidIndex) entries_[x.prev].next = x.next;
   else head_ = x.next;
-  if (x.next != kNone) entries_[x.next].prev = x.prev;
+  if (x.next != kInvalidIndex) entries_[x.next].prev = x.prev;
   else tail_ = x.prev;
-  x.prev = x.next = kNone;
+  x.prev = x.next = kInvalidIndex;
 }
 
 void ChunkCache::pushFront(uint32_t e) {
   Entry& x = entries_[e];
-  x.prev = kNone;
+  x.prev = kInvalidIndex;
   x.next = head_;
-  if (head_ != kNone) entries_[head_].prev = e;
+  if (head_ != kInvalidIndex) entries_[head_].prev = e;
   head_ = e;
-  if (tail_ == kNone) tail_ = e;
+  if (tail_ == kInvalidIndex) tail_ = e;
 }
 
 void ChunkCache::drop(uint32_t e) {
@@ -40,7 +40,7 @@ void ChunkCache::drop(uint32_t e) {
 }
 
 void ChunkCache::evictToBudget(uint32_t keep) {
-  while (bytes_ > budget_ && tail_ != kNone && tail_ != keep) {
+  while (bytes_ > budget_ && tail_ != kInvalidIndex && tail_ != keep) {
     drop(tail_);
     ++stats_.evictions;
   }
@@ -49,7 +49,7 @@ void ChunkCache::evictToBudget(uint32_t keep) {
 const ChunkCollision& ChunkCache::get(const Int3& chunk, const VoxelTerrain& voxels, float voxelSize) {
   const uint64_t key = chunkKey(chunk);
   uint32_t e = index_.find(key);
-  if (e != ChunkKeyMap::kNotFound) {
+  if (e != kInvalidIndex) {
     ++stats_.hits;
     if (head_ != e) {
       unlink(e);
@@ -58,7 +58,7 @@ const ChunkCollision& ChunkCache::get(const Int3& chunk, const VoxelTerrain& vox
     return entries_[e].data;
   }
   ++stats_.misses;
-  if (freeHead_ != kNone) {
+  if (freeHead_ != kInvalidIndex) {
     e = freeHead_;
     freeHead_ = entries_[e].next;
   } else {
@@ -83,7 +83,7 @@ const ChunkCollision& ChunkCache::get(const Int3& chunk, const VoxelTerrain& vox
 
 void ChunkCache::invalidate(const Int3& chunk) {
   const uint32_t e = index_.find(chunkKey(chunk));
-  if (e == ChunkKeyMap::kNotFound) return;
+  if (e == kInvalidIndex) return;
   drop(e);
   ++stats_.invalidations;
 }
@@ -96,7 +96,7 @@ void ChunkCache::invalidateAround(const Int3& lo, const Int3& hi) {
   const uint64_t range = uint64_t(chi.x - clo.x + 1) * uint64_t(chi.y - clo.y + 1) * uint64_t(chi.z - clo.z + 1);
   if (range > index_.size()) {
     // A big edit: walk the cached entries instead of the chunk range.
-    for (uint32_t e = head_; e != kNone;) {
+    for (uint32_t e = head_; e != kInvalidIndex;) {
       const uint32_t next = entries_[e].next;
       const Int3 c = chunkCoordFromKey(entries_[e].key);
       if (c.x >= clo.x && c.x <= chi.x && c.y >= clo.y && c.y <= chi.y && c.z >= clo.z && c.z <= chi.z) {
@@ -113,7 +113,7 @@ void ChunkCache::invalidateAround(const Int3& lo, const Int3& hi) {
 }
 
 void ChunkCache::invalidateAll() {
-  while (head_ != kNone) {
+  while (head_ != kInvalidIndex) {
     drop(head_);
     ++stats_.invalidations;
   }
@@ -121,7 +121,7 @@ void ChunkCache::invalidateAll() {
 
 void ChunkCache::setBudget(size_t budgetBytes) {
   budget_ = budgetBytes;
-  evictToBudget(kNone);
+  evictToBudget(kInvalidIndex);
 }
 
 }  // namespace bw

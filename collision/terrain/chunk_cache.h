@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "collision/core/ids.h"
 #include "collision/terrain/chunk_key_map.h"
 #include "collision/terrain/loose_kd_tree.h"
 #include "collision/terrain/voxel_terrain.h"
@@ -48,7 +49,7 @@ class ChunkCache {
   /// The chunk's collision data, meshed and built now if not cached.
   const ChunkCollision& get(const Int3& chunk, const VoxelTerrain& voxels, float voxelSize);
   /// True if the chunk's data is cached (does not touch the LRU order).
-  bool contains(const Int3& chunk) const { return index_.find(chunkKey(chunk)) != ChunkKeyMap::kNotFound; }
+  bool contains(const Int3& chunk) const { return index_.find(chunkKey(chunk)) != kInvalidIndex; }
   /// Drops the chunk's data (voxels in its 10^3 neighbourhood changed).
   void invalidate(const Int3& chunk);
   /// Drops every chunk whose 10^3 neighbourhood contains a voxel of [lo, hi] (inclusive).
@@ -70,13 +71,12 @@ class ChunkCache {
   void resetStats() { stats_ = {}; }
 
  private:
-  static constexpr uint32_t kNone = 0xFFFFFFFFu;
   struct Entry {
     ChunkCollision data;
     uint64_t key = 0;
     size_t bytes = 0;
-    uint32_t prev = kNone;  // towards most recently used
-    uint32_t next = kNone;  // towards least recently used; free-list link when unused
+    uint32_t prev = kInvalidIndex;  // towards most recently used
+    uint32_t next = kInvalidIndex;  // towards least recently used; free-list link when unused
   };
 
   void unlink(uint32_t e);
@@ -86,7 +86,7 @@ class ChunkCache {
 
   std::vector<Entry> entries_;
   ChunkKeyMap index_;
-  uint32_t head_ = kNone, tail_ = kNone, freeHead_ = kNone;
+  uint32_t head_ = kInvalidIndex, tail_ = kInvalidIndex, freeHead_ = kInvalidIndex;
   size_t budget_;
   size_t bytes_ = 0;
   ChunkCacheStats stats_;

@@ -10,19 +10,20 @@
 #include <cstdint>
 #include <vector>
 
+#include "collision/core/ids.h"
+
 namespace bw {
 
 class ChunkKeyMap {
  public:
-  static constexpr uint32_t kNotFound = 0xFFFFFFFFu;  ///< returned by find for a missing key
 
-  /// The value stored for key, or kNotFound.
+  /// The value stored for key, or kInvalidIndex.
   uint32_t find(uint64_t key) const {
-    if (size_ == 0) return kNotFound;
+    if (size_ == 0) return kInvalidIndex;
     for (size_t i = slotFor(key);; i = (i + 1) & mask_) {
       const Slot& s = slots_[i];
       if (s.key == key) return s.value;
-      if (s.key == kEmptyKey) return kNotFound;
+      if (s.key == kEmptyKey) return kInvalidIndex;
     }
   }
   /// Inserts or overwrites key -> value.

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "collision/aabb.h"
-#include "collision/ray.h"
+#include "collision/core/aabb.h"
+#include "collision/core/ray.h"
 #include "collision/terrain/ray_triangle.h"
 #include "collision/terrain/triangle_mesh.h"
 

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "collision/math_types.h"
+#include "collision/core/math_types.h"
 
 namespace bw {
 

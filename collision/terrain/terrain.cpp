@@ -1,6 +1,6 @@
 #include "collision/terrain/terrain.h"
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 namespace {

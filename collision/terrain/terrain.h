@@ -16,7 +16,7 @@
 /// cached meshes. Thread safety: none; edit and query from one thread (queries fill the cache).
 #include <cstddef>
 
-#include "collision/rigid_transform.h"
+#include "collision/core/rigid_transform.h"
 #include "collision/terrain/bitmask_broadphase.h"
 #include "collision/terrain/chunk_cache.h"
 #include "collision/terrain/voxel_terrain.h"

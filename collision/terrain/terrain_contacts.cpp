@@ -7,15 +7,12 @@
 #include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
 #include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
-#include <LinearMath/btConvexHullComputer.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 #include "collision/terrain/triangle_contacts.h"
 
 namespace bw {
@@ -36,27 +33,27 @@ struct LocalShape {
   uint32_t vertexCount() const { return points ? pointCount : 8u; }
 };
 
-LocalShape placeShape(const TerrainContactShape& s, const Vec3f& centre, const Quatf& rot) {
+LocalShape placeShape(const QueryShape& s, const Vec3f& centre, const Quatf& rot) {
   LocalShape l{centre, rot.toRotationMatrix(), Vec3f::Zero(), {}, nullptr, 0};
   switch (s.kind) {
-    case TerrainContactShape::Kind::Sphere:
+    case QueryShape::Kind::Sphere:
       l.halfBounds = Vec3f::Constant(s.radius);
       break;
-    case TerrainContactShape::Kind::Capsule:
-      l.halfBounds = (l.rot.col(1) * s.halfHeight).cwiseAbs() + Vec3f::Constant(s.radius);
+    case QueryShape::Kind::Capsule:
+      l.halfBounds = (l.rot.col(2) * s.halfHeight).cwiseAbs() + Vec3f::Constant(s.radius);
       break;
-    case TerrainContactShape::Kind::Box:
+    case QueryShape::Kind::Box:
       l.halfBounds = l.rot.cwiseAbs() * s.halfExtents;
       for (int k = 0; k < 8; ++k) {
         const Vec3f sgn((k & 1) ? 1.f : -1.f, (k & 2) ? 1.f : -1.f, (k & 4) ? 1.f : -1.f);
         l.corners[k] = l.rot * s.halfExtents.cwiseProduct(sgn) + centre;
       }
       break;
-    case TerrainContactShape::Kind::ConvexHull: {
-      l.points = s.hullPoints;
-      l.pointCount = s.hullPointCount;
+    case QueryShape::Kind::Hull: {
+      l.points = s.points;
+      l.pointCount = s.pointCount;
       Vec3f m = Vec3f::Zero();
-      for (uint32_t i = 0; i < s.hullPointCount; ++i) m = m.cwiseMax((l.rot * s.hullPoints[i]).cwiseAbs());
+      for (uint32_t i = 0; i < s.pointCount; ++i) m = m.cwiseMax((l.rot * s.points[i]).cwiseAbs());
       l.halfBounds = m;
       break;
     }
@@ -114,98 +111,14 @@ uint32_t featureOf(const Int3& chunk, uint32_t triangle) {
   return (c << 13) | triangle;
 }
 
+// Checks what both terrain queries take: a valid shape at a finite, unit-rotation pose.
+void validatePlacedShape(const QueryShape& shape, const RigidTransform& pose, const char* context) {
+  shape.validate(context);
+  requireFinite(pose.translation, context, "pose.translation");
+  requireUnitQuaternion(pose.rotation, context, "pose.rotation");
+}
+
 }  // namespace
-
-TerrainContactShape TerrainContactShape::sphere(const Vec3d& centre, float radius) {
-  TerrainContactShape s;
-  s.kind = Kind::Sphere;
-  s.position = centre;
-  s.radius = radius;
-  return s;
-}
-
-TerrainContactShape TerrainContactShape::capsule(const Vec3d& centre, const Quatf& rotation, float halfHeight, float radius) {
-  TerrainContactShape s;
-  s.kind = Kind::Capsule;
-  s.position = centre;
-  s.rotation = rotation;
-  s.halfHeight = halfHeight;
-  s.radius = radius;
-  return s;
-}
-
-TerrainContactShape TerrainContactShape::box(const Vec3d& centre, const Quatf& rotation, const Vec3f& halfExtents) {
-  TerrainContactShape s;
-  s.kind = Kind::Box;
-  s.position = centre;
-  s.rotation = rotation;
-  s.halfExtents = halfExtents;
-  return s;
-}
-
-TerrainContactShape TerrainContactShape::convexHull(const Vec3d& centre, const Quatf& rotation, const Vec3f* points,
-                                                    uint32_t count) {
-  if (!points || count < 4) throw InvalidInput("TerrainContactShape::convexHull: count is below 4 or points is null");
-  for (uint32_t i = 0; i < count; ++i) requireFinite(points[i], "TerrainContactShape::convexHull", "points[i]");
-  TerrainContactShape s;
-  s.kind = Kind::ConvexHull;
-  s.position = centre;
-  s.rotation = rotation;
-  s.hullPoints = points;
-  s.hullPointCount = count;
-  btConvexHullComputer hull;
-  hull.compute(&points[0].x(), int(sizeof(Vec3f)), int(count), 0.f, 0.f);
-  double vol = 0;
-  for (int f = 0; f < hull.faces.size(); ++f) {
-    const btConvexHullComputer::Edge* first = &hull.edges[hull.faces[f]];
-    const btVector3& a = hull.vertices[first->getSourceVertex()];
-    for (const btConvexHullComputer::Edge* e = first->getNextEdgeOfFace(); e != first; e = e->getNextEdgeOfFace()) {
-      const btVector3& b = hull.vertices[e->getSourceVertex()];
-      const btVector3& c = hull.vertices[e->getTargetVertex()];
-      vol += double(a.dot(b.cross(c))) / 6.0;
-    }
-  }
-  s.hullVolume = float(std::abs(vol));
-  if (!(s.hullVolume > 0.f)) throw InvalidInput("TerrainContactShape::convexHull: points are coplanar (zero volume)");
-  return s;
-}
-
-float TerrainContactShape::volume() const {
-  constexpr float pi = std::numbers::pi_v<float>;
-  switch (kind) {
-    case Kind::Sphere:
-      return 4.f / 3.f * pi * radius * radius * radius;
-    case Kind::Capsule:
-      return pi * radius * radius * (4.f / 3.f * radius + 2.f * halfHeight);
-    case Kind::Box:
-      return 8.f * halfExtents.prod();
-    case Kind::ConvexHull:
-      return hullVolume;
-  }
-  return 0.f;
-}
-
-void TerrainContactShape::validate(const char* context) const {
-  requireFinite(position, context, "shape.position");
-  requireUnitQuaternion(rotation, context, "shape.rotation");
-  switch (kind) {
-    case Kind::Sphere:
-      requireInRange(radius, 1e-6, 1e6, context, "shape.radius");
-      break;
-    case Kind::Capsule:
-      requireInRange(radius, 1e-6, 1e6, context, "shape.radius");
-      requireInRange(halfHeight, 0, 1e6, context, "shape.halfHeight");
-      break;
-    case Kind::Box:
-      for (int i = 0; i < 3; ++i) requireInRange(halfExtents[i], 1e-6, 1e6, context, "shape.halfExtents");
-      break;
-    case Kind::ConvexHull:
-      if (!hullPoints || hullPointCount < 4 || !(hullVolume > 0.f)) {
-        throw InvalidInput(std::string(context) + ": shape hull was not made by TerrainContactShape::convexHull");
-      }
-      break;
-  }
-}
 
 void dropInteriorEdgeContacts(std::vector<Contact>& out, size_t begin, const std::vector<Vec3f>& faceNormals) {
   if (faceNormals.size() != out.size() - begin) {
@@ -234,8 +147,9 @@ void dropInteriorEdgeContacts(std::vector<Contact>& out, size_t begin, const std
   out.resize(w);
 }
 
-size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float spec, std::vector<Contact>& out) {
-  shape.validate("terrainContacts");
+size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec,
+                       std::vector<Contact>& out) {
+  validatePlacedShape(shape, pose, "terrainContacts");
   requireInRange(spec, 0.0, 1e6, "terrainContacts", "speculativeDistance");
   const size_t before = out.size();
   // Face normal (world) of the triangle behind each contact appended by this call.
@@ -243,7 +157,7 @@ size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float
   thread_local std::vector<Vec3f> faceNormals;
   faceNormals.clear();
   const RigidTransform& place = terrain.placement();
-  const LocalShape inTerrain = placeShape(shape, place.pointToLocal(shape.position), place.rotationToLocal(shape.rotation));
+  const LocalShape inTerrain = placeShape(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation));
   const Aabb terrainBox = Aabb::fromCenterHalf(inTerrain.centre, inTerrain.halfBounds).expanded(spec);
   VoxelRange range;
   if (!terrain.broadphase().voxelRangeOf(terrainBox, terrain.voxelSize(), range)) return 0;
@@ -252,8 +166,8 @@ size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float
   btBoxShape btBox(toBt(shape.halfExtents.cwiseMax(Vec3f::Constant(1e-6f))));
   btBox.setMargin(0.f);
   btConvexHullShape btHull;
-  if (shape.kind == TerrainContactShape::Kind::ConvexHull) {
-    for (uint32_t i = 0; i < shape.hullPointCount; ++i) btHull.addPoint(toBt(shape.hullPoints[i]), false);
+  if (shape.kind == QueryShape::Kind::Hull) {
+    for (uint32_t i = 0; i < shape.pointCount; ++i) btHull.addPoint(toBt(shape.points[i]), false);
     btHull.recalcLocalAabb();
     btHull.setMargin(0.f);
   }
@@ -263,8 +177,8 @@ size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float
     const ChunkCollision& cc = terrain.chunkCollision(chunk);
     if (cc.mesh.triangleCount() == 0) return;
     const RigidTransform xf = terrain.chunkTransform(chunk);
-    const Quatf localRot = xf.rotationToLocal(shape.rotation);
-    const LocalShape ls = placeShape(shape, xf.pointToLocal(shape.position), localRot);
+    const Quatf localRot = xf.rotationToLocal(pose.rotation);
+    const LocalShape ls = placeShape(shape, xf.pointToLocal(pose.translation), localRot);
     const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds).expanded(spec);
     btTransform btXf(btQuaternion(localRot.x(), localRot.y(), localRot.z(), localRot.w()), toBt(ls.centre));
     const TriangleMeshView mesh = cc.mesh.view();
@@ -278,20 +192,20 @@ size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float
       LocalContact lc[8];
       int k = 0;
       switch (shape.kind) {
-        case TerrainContactShape::Kind::Sphere:
+        case QueryShape::Kind::Sphere:
           k = sphereTriangle(ls.centre, shape.radius, a, b, c, n, spec, lc[0]) ? 1 : 0;
           break;
-        case TerrainContactShape::Kind::Capsule: {
-          const Vec3f axis = ls.rot.col(1) * shape.halfHeight;
+        case QueryShape::Kind::Capsule: {
+          const Vec3f axis = ls.rot.col(2) * shape.halfHeight;
           LocalContact two[2];
           k = capsuleTriangle(ls.centre - axis, ls.centre + axis, shape.radius, a, b, c, n, spec, two);
           std::copy(two, two + k, lc);
           break;
         }
-        case TerrainContactShape::Kind::Box:
+        case QueryShape::Kind::Box:
           k = convexTriangle(btBox, btXf, ls, a, b, c, n, spec, lc, 8);
           break;
-        case TerrainContactShape::Kind::ConvexHull:
+        case QueryShape::Kind::Hull:
           k = convexTriangle(btHull, btXf, ls, a, b, c, n, spec, lc, 8);
           break;
       }
@@ -317,11 +231,11 @@ size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float
   return out.size() - before;
 }
 
-bool terrainWaterContact(const Terrain& terrain, const TerrainContactShape& shape, WaterContact& out) {
-  shape.validate("terrainWaterContact");
+bool terrainWaterContact(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out) {
+  validatePlacedShape(shape, pose, "terrainWaterContact");
   out = {};
   const RigidTransform& place = terrain.placement();
-  const LocalShape ls = placeShape(shape, place.pointToLocal(shape.position), place.rotationToLocal(shape.rotation));
+  const LocalShape ls = placeShape(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation));
   const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds);
   if (!terrain.overlapLocal(box).water) return false;
   const float vs = terrain.voxelSize();

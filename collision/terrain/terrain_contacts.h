@@ -3,9 +3,9 @@
 /// chunk triangles (for the solver) and a water estimate (for buoyancy).
 ///
 ///   std::vector<Contact> contacts;                       // reuse across frames
-///   terrainContacts(terrain, TerrainContactShape::sphere(p, 0.5f), 0.02f, contacts);
+///   terrainContacts(terrain, QueryShape::sphere(0.5f), RigidTransform{p, q}, 0.02f, contacts);
 ///   WaterContact w;
-///   if (terrainWaterContact(terrain, shape, w)) applyBuoyancy(w.submergedVolume, w.centreOfBuoyancy);
+///   if (terrainWaterContact(terrain, shape, pose, w)) applyBuoyancy(w.submergedVolume, w.centreOfBuoyancy);
 ///
 /// Pipeline per shape: terrain-local bounds -> bitmask broadphase (chunks touching solid) ->
 /// chunk mesh + kD tree from the cache -> kD AABB query in chunk-local floats -> per-triangle
@@ -21,43 +21,18 @@
 #include <cstdint>
 #include <vector>
 
-#include "collision/contact.h"
+#include "collision/bricks/contact.h"
+#include "collision/bricks/query_shape.h"
+#include "collision/core/rigid_transform.h"
 #include "collision/terrain/terrain.h"
 
 namespace bw {
 
-/// A convex query shape in world space.
-struct TerrainContactShape {
-  /// Which shape this is.
-  enum class Kind : uint8_t { Sphere, Capsule, Box, ConvexHull };
-  Kind kind = Kind::Sphere;          ///< which fields below matter
-  Vec3d position = Vec3d::Zero();    ///< world centre
-  Quatf rotation = Quatf::Identity();  ///< world orientation (ignored for spheres)
-  float radius = 0.f;                ///< sphere and capsule radius
-  float halfHeight = 0.f;            ///< capsule: half length of the core segment along local Y
-  Vec3f halfExtents = Vec3f::Zero(); ///< box half extents
-  const Vec3f* hullPoints = nullptr; ///< hull points in the shape's frame (caller keeps them alive)
-  uint32_t hullPointCount = 0;       ///< number of hull points
-  float hullVolume = 0.f;            ///< volume of the hull (computed by convexHull())
-
-  /// A sphere.
-  static TerrainContactShape sphere(const Vec3d& centre, float radius);
-  /// A capsule whose core segment runs along its local Y axis.
-  static TerrainContactShape capsule(const Vec3d& centre, const Quatf& rotation, float halfHeight, float radius);
-  /// A box.
-  static TerrainContactShape box(const Vec3d& centre, const Quatf& rotation, const Vec3f& halfExtents);
-  /// The convex hull of `count` points (>= 4, not coplanar); computes its volume once.
-  static TerrainContactShape convexHull(const Vec3d& centre, const Quatf& rotation, const Vec3f* points, uint32_t count);
-
-  /// Volume of the shape.
-  float volume() const;
-  /// Throws InvalidInput for NaN/inf or non-positive sizes.
-  void validate(const char* context) const;
-};
-
-/// Appends the shape's solid contacts with every terrain triangle within
-/// `speculativeDistance` (depth > -speculativeDistance). Returns the number appended.
-size_t terrainContacts(Terrain& terrain, const TerrainContactShape& shape, float speculativeDistance,
+/// Appends the solid contacts of `shape`, placed in the world by `pose` (its centre and
+/// orientation), with every terrain triangle within `speculativeDistance` (depth >
+/// -speculativeDistance). Returns the number appended. Throws InvalidInput for a bad shape,
+/// pose or distance.
+size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float speculativeDistance,
                        std::vector<Contact>& out);
 
 /// Interior edges: a shape resting on a flat area made of many triangles touches the
@@ -80,6 +55,6 @@ struct WaterContact {
 /// bounding box with each water voxel's filled part (occupancy / 255 of the cell from its
 /// bottom), scaled by shape volume / box volume (exact for an axis-aligned box, an estimate
 /// otherwise). Returns false when the broadphase sees no water.
-bool terrainWaterContact(const Terrain& terrain, const TerrainContactShape& shape, WaterContact& out);
+bool terrainWaterContact(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out);
 
 }  // namespace bw

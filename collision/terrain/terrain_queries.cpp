@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 namespace {

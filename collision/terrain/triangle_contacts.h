@@ -1,7 +1,7 @@
 #pragma once
 /// Closed-form contacts between round shapes and one terrain triangle, in a chunk's local
 /// frame. One-sided: a triangle is a face of a solid, its normal (b - a) x (c - a) points out.
-#include "collision/math_types.h"
+#include "collision/core/math_types.h"
 
 namespace bw {
 

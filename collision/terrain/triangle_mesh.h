@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "collision/math_types.h"
+#include "collision/core/math_types.h"
 
 namespace bw {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 namespace {
@@ -43,14 +43,14 @@ VoxelTerrain::VoxelTerrain(const Int3& sizeInVoxels)
 Voxel VoxelTerrain::get(const Int3& v) const {
   if (!contains(v)) return Voxel{};
   const uint32_t idx = keys_.find(chunkKey({v.x >> kChunkShift, v.y >> kChunkShift, v.z >> kChunkShift}));
-  if (idx == ChunkKeyMap::kNotFound) return Voxel{};
+  if (idx == kInvalidIndex) return Voxel{};
   return pool_[idx].voxels[chunkVoxelIndex(v.x & 7, v.y & 7, v.z & 7)];
 }
 
 const VoxelChunk* VoxelTerrain::chunk(const Int3& c) const {
   if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= chunkGrid_.x || c.y >= chunkGrid_.y || c.z >= chunkGrid_.z) return nullptr;
   const uint32_t idx = keys_.find(chunkKey(c));
-  return idx == ChunkKeyMap::kNotFound ? nullptr : &pool_[idx];
+  return idx == kInvalidIndex ? nullptr : &pool_[idx];
 }
 
 void VoxelTerrain::set(const Int3& v, Voxel voxel) {
@@ -72,7 +72,7 @@ void VoxelTerrain::fillBox(const Int3& lo, const Int3& hi, Voxel voxel) {
       for (int cx = lo.x >> kChunkShift; cx <= hi.x >> kChunkShift; ++cx) {
         const uint64_t key = chunkKey({cx, cy, cz});
         uint32_t idx = keys_.find(key);
-        if (idx == ChunkKeyMap::kNotFound) {
+        if (idx == kInvalidIndex) {
           if (voxel.isAir()) continue;
           idx = pool_.allocate();
           keys_.insert(key, idx);
@@ -103,7 +103,7 @@ void VoxelTerrain::fillBox(const Int3& lo, const Int3& hi, Voxel voxel) {
 void VoxelTerrain::writeVoxel(const Int3& v, Voxel voxel) {
   const uint64_t key = chunkKey({v.x >> kChunkShift, v.y >> kChunkShift, v.z >> kChunkShift});
   uint32_t idx = keys_.find(key);
-  if (idx == ChunkKeyMap::kNotFound) {
+  if (idx == kInvalidIndex) {
     if (voxel.isAir()) return;
     idx = pool_.allocate();
     keys_.insert(key, idx);

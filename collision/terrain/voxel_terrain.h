@@ -12,9 +12,9 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "collision/core/virtual_pool.h"
 #include "collision/terrain/chunk_key_map.h"
 #include "collision/terrain/voxel_chunk.h"
-#include "collision/virtual_pool.h"
 
 namespace bw {
 

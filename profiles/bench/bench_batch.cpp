@@ -9,9 +9,8 @@
 //     time = update time per frame, records into per-id slots (no render side).
 // Each runs 3 repetitions (other processes share the cores); the ratio table after the runs
 // uses the medians and compares them with the article and the goals.
-#include <benchmark/benchmark.h>
-
 #include <algorithm>
+#include <benchmark/benchmark.h>
 #include <cstdio>
 #include <map>
 #include <string>

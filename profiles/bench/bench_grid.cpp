@@ -9,17 +9,16 @@
 // ConvexApprox/<build>/<depth>: hull build time, hull volume / brick volume, box or not.
 // btCompound/<bricks>: the same bricks as a btCompoundShape: build time, bytes per brick,
 //   contactPairTest time for the same poses. The summary prints the ratios.
-#include <btBulletCollisionCommon.h>
 #include <benchmark/benchmark.h>
-
+#include <btBulletCollisionCommon.h>
 #include <chrono>
 #include <cstdio>
 #include <map>
 #include <memory>
 
-#include "collision/brick_grid.h"
-#include "collision/build_generators.h"
-#include "collision/seeded_random.h"
+#include "collision/bricks/brick_grid.h"
+#include "collision/content/build_generators.h"
+#include "collision/core/seeded_random.h"
 
 namespace {
 

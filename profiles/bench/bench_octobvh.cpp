@@ -11,10 +11,9 @@
 // <Index>, LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs
 // reversed child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again.
 // After the run a summary prints each comparison's ratio.
-#include <btBulletCollisionCommon.h>
 #include <BulletCollision/BroadphaseCollision/btDbvt.h>
 #include <benchmark/benchmark.h>
-
+#include <btBulletCollisionCommon.h>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -23,13 +22,13 @@
 #include <span>
 #include <string>
 
-#include "collision/brick_geometry.h"
-#include "collision/brick_workload.h"
-#include "collision/brs_reader.h"
-#include "collision/build_tiling.h"
-#include "collision/loose_octree.h"
-#include "collision/octobvh.h"
-#include "collision/seeded_random.h"
+#include "collision/bricks/brick_geometry.h"
+#include "collision/content/brick_workload.h"
+#include "collision/content/brs_reader.h"
+#include "collision/content/build_tiling.h"
+#include "collision/core/seeded_random.h"
+#include "collision/index/loose_octree.h"
+#include "collision/index/octobvh.h"
 
 namespace {
 

@@ -4,14 +4,13 @@
 //
 // Counters: ns_per_op (mean), worst_push_us (the slowest single push of the run: for
 // std::vector this is the reallocation that copies every element), resident_MiB.
-#include <benchmark/benchmark.h>
-
 #include <algorithm>
+#include <benchmark/benchmark.h>
 #include <chrono>
 #include <random>
 #include <vector>
 
-#include "collision/virtual_pool.h"
+#include "collision/core/virtual_pool.h"
 
 namespace {
 

@@ -2,18 +2,17 @@
 /// cost; loose kD tree vs Bullet's btBvhTriangleMeshShape (quantized and not) on the same
 /// chunk meshes and on one ~1M-triangle heightfield, both sides in the same run; mesher and
 /// cached terrain raycasts. Figures are Google Benchmark counters.
+#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
 #include <benchmark/benchmark.h>
 #include <btBulletCollisionCommon.h>
-#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
-
 #include <memory>
 #include <random>
 #include <vector>
 
+#include "collision/content/terrain_generator.h"
 #include "collision/terrain/chunk_mesher.h"
 #include "collision/terrain/loose_kd_tree.h"
 #include "collision/terrain/terrain.h"
-#include "collision/terrain/terrain_generator.h"
 #include "collision/terrain/terrain_queries.h"
 
 namespace bw {

@@ -10,8 +10,8 @@
 // Counters: pairs per frame, interval/box tests per frame.
 #include <benchmark/benchmark.h>
 
-#include "collision/octobvh.h"
-#include "collision/seeded_random.h"
+#include "collision/core/seeded_random.h"
+#include "collision/index/octobvh.h"
 #include "world/broadphase.h"
 
 namespace {

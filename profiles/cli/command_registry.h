@@ -8,7 +8,6 @@
 /// The setup function adds options to the subcommand and returns the action to run when the
 /// subcommand is chosen; the action returns the process exit code.
 #include <CLI/CLI.hpp>
-
 #include <functional>
 #include <string>
 #include <vector>

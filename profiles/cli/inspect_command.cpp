@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "cli/command_registry.h"
-#include "collision/brick_grid.h"
-#include "collision/brs_reader.h"
-#include "collision/input_validation.h"
-#include "collision/terrain/vox_reader.h"
+#include "collision/bricks/brick_grid.h"
+#include "collision/content/brs_reader.h"
+#include "collision/content/vox_reader.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw::cli {
 namespace {

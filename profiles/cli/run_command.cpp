@@ -11,10 +11,10 @@
 
 #include "cli/command_registry.h"
 #include "cli/scene_run.h"
-#include "collision/brick_workload.h"
-#include "collision/octobvh.h"
-#include "collision/seeded_random.h"
-#include "collision/virtual_pool.h"
+#include "collision/content/brick_workload.h"
+#include "collision/core/seeded_random.h"
+#include "collision/core/virtual_pool.h"
+#include "collision/index/octobvh.h"
 
 namespace bw::cli {
 namespace {

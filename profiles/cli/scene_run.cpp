@@ -1,16 +1,15 @@
 #include "cli/scene_run.h"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <cmath>
 #include <fstream>
-#include <limits>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <sys/resource.h>
 #include <vector>
 
 #include "world/bullet_baseline.h"

@@ -1,14 +1,12 @@
 // Brick shapes and grids: exact geometry, mass properties, raycasts and contacts against brute
 // force over every brick, collision LOD, convex approximation, grid vs grid, edits, bad input.
-#include "collision/brick_grid.h"
-
-#include <gtest/gtest.h>
-
 #include <algorithm>
+#include <gtest/gtest.h>
 #include <map>
 
-#include "collision/input_validation.h"
-#include "collision/seeded_random.h"
+#include "collision/bricks/brick_grid.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/seeded_random.h"
 
 namespace bw {
 namespace {

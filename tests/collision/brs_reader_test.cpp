@@ -1,23 +1,22 @@
 // The .brs reader against the real Lighthouse_Island save (counts and extents computed
 // independently of the reader) and against hand-built saves of versions 8, 9 and 10, plus bad
 // files: each must fail with InvalidInput naming the file, never crash or half-load.
-#include <gtest/gtest.h>
-#include <zlib.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <map>
 #include <string>
 #include <vector>
+#include <zlib.h>
 
-#include "collision/brick.h"
-#include "collision/brick_grid.h"
-#include "collision/brick_geometry.h"
-#include "collision/brs_reader.h"
-#include "collision/input_validation.h"
+#include "collision/bricks/brick.h"
+#include "collision/bricks/brick_geometry.h"
+#include "collision/bricks/brick_grid.h"
+#include "collision/content/brs_reader.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 namespace {

@@ -4,9 +4,9 @@
 #include <map>
 #include <vector>
 
-#include "collision/obb.h"
-#include "collision/ray.h"
-#include "collision/spatial_query_types.h"
+#include "collision/core/obb.h"
+#include "collision/core/ray.h"
+#include "collision/index/spatial_query_types.h"
 
 namespace bw::test {
 

@@ -1,20 +1,18 @@
 // Tests of the seeded build generators (collision/build_generators.h): valid bricks,
 // determinism, the scale law, bounds, empty interiors, the city block's microbricks beside long
 // ramps, the ring station's floor radius and the absence of self-overlap.
-#include "collision/build_generators.h"
-
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <gtest/gtest.h>
 #include <set>
 #include <unordered_map>
 
-#include "collision/brick_geometry.h"
-#include "collision/input_validation.h"
-#include "collision/seeded_random.h"
+#include "collision/bricks/brick_geometry.h"
+#include "collision/content/build_generators.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/seeded_random.h"
 
 namespace bw {
 namespace {

@@ -43,22 +43,21 @@
 //   lodFraction, speculativeMargin) and NaN overlap boxes throw InvalidInput naming the
 //   argument, and leave the grid/tree unchanged (counts, edit count, structure hash, mass,
 //   query answers).
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <gtest/gtest.h>
 #include <limits>
 #include <string>
 
+#include "collision/bricks/brick_grid.h"
+#include "collision/content/brick_workload.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/seeded_random.h"
+#include "collision/index/octobvh.h"
 #include "brute_force_index.h"
-#include "collision/brick_grid.h"
-#include "collision/brick_workload.h"
-#include "collision/input_validation.h"
-#include "collision/octobvh.h"
-#include "collision/seeded_random.h"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define BW_EXTREMES_SANITIZED 1

@@ -1,18 +1,17 @@
 // Math types: axis rotations, OBB overlap, ray slab tests, precision rule, input validation.
-#include <btBulletCollisionCommon.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
-#include <gtest/gtest.h>
-
+#include <btBulletCollisionCommon.h>
 #include <cmath>
+#include <gtest/gtest.h>
 #include <limits>
 #include <random>
 #include <set>
 
-#include "collision/axis_rotation.h"
-#include "collision/input_validation.h"
-#include "collision/obb.h"
-#include "collision/ray.h"
-#include "collision/rigid_transform.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/axis_rotation.h"
+#include "collision/core/obb.h"
+#include "collision/core/ray.h"
+#include "collision/core/rigid_transform.h"
 
 namespace bw {
 namespace {

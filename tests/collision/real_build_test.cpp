@@ -7,11 +7,10 @@
 // note: brute-force references that call an expensive exact test (GJK sweeps and contacts) first
 // reject bricks whose bounds, grown by a slack the index does not use, miss the query: every
 // brick is still visited, and the slack lets the reference find hits the index's pruning would not.
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <gtest/gtest.h>
 #include <limits>
 #include <map>
 #include <set>
@@ -19,12 +18,12 @@
 #include <string>
 #include <vector>
 
+#include "collision/bricks/brick_grid.h"
+#include "collision/content/brs_reader.h"
+#include "collision/content/build_tiling.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/seeded_random.h"
 #include "brute_force_index.h"
-#include "collision/brick_grid.h"
-#include "collision/brs_reader.h"
-#include "collision/build_tiling.h"
-#include "collision/input_validation.h"
-#include "collision/seeded_random.h"
 
 namespace bw {
 namespace {

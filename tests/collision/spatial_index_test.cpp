@@ -1,17 +1,16 @@
 // Differential tests of the spatial indices (OctoBVH and the loose-octree baseline) against
 // brute force, on seeded workloads with sizes 0.04..500, thin plates, clustered placement and
 // coordinates far from the origin, after random edit sequences.
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
+#include <gtest/gtest.h>
 
+#include "collision/content/brick_workload.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/seeded_random.h"
+#include "collision/index/loose_octree.h"
+#include "collision/index/octobvh.h"
 #include "brute_force_index.h"
-#include "collision/brick_workload.h"
-#include "collision/input_validation.h"
-#include "collision/loose_octree.h"
-#include "collision/octobvh.h"
-#include "collision/seeded_random.h"
 
 namespace bw {
 namespace {

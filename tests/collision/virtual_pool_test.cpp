@@ -1,15 +1,13 @@
 // VirtualPool: stable addresses, memory returned in any order, slot reuse, clear errors.
-#include "collision/virtual_pool.h"
-
-#include <gtest/gtest.h>
-
 #include <algorithm>
+#include <gtest/gtest.h>
 #include <map>
 #include <numeric>
 #include <random>
 #include <set>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/virtual_pool.h"
 
 namespace bw {
 namespace {

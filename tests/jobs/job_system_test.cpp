@@ -1,14 +1,12 @@
 // JobSystem: every item visited once, fixed chunking, bit-identical reductions per thread count.
-#include "jobs/job_system.h"
-
-#include <gtest/gtest.h>
-
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <gtest/gtest.h>
 #include <vector>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
+#include "jobs/job_system.h"
 
 namespace bw {
 namespace {

@@ -1,15 +1,13 @@
 // Profiler: work/span figures, per-thread recording, Chrome trace output.
-#include "jobs/profiler.h"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "jobs/job_system.h"
+#include "jobs/profiler.h"
 
 namespace bw {
 namespace {

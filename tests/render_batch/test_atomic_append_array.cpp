@@ -1,8 +1,7 @@
 // AtomicAppendArray under contention (plain std::threads, so ThreadSanitizer sees everything):
 // no append lost or duplicated, overflow refused and reported, never written out of bounds.
-#include <gtest/gtest.h>
-
 #include <algorithm>
+#include <gtest/gtest.h>
 #include <thread>
 #include <vector>
 

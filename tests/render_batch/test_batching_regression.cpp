@@ -3,13 +3,12 @@
 // Checks byte-identical render scenes, exact update counts per frame (nothing lost or
 // duplicated), the radius refresh only on the per-object path, the frame fence, and overflow.
 #include <gtest/gtest.h>
-
 #include <memory>
 #include <ostream>
 #include <random>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 #include "jobs/job_system.h"
 #include "render_batch/batched_submitter.h"
 #include "render_batch/mutex_command_queue.h"

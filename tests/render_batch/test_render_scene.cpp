@@ -1,7 +1,7 @@
 // RenderScene: applying updates, idempotent radius refresh, byte-identical comparison.
 #include <gtest/gtest.h>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 #include "render_batch/render_scene.h"
 #include "transforms/attachment_math.h"
 

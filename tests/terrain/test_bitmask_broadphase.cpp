@@ -1,10 +1,9 @@
-#include <gtest/gtest.h>
-
 #include <algorithm>
+#include <gtest/gtest.h>
 #include <random>
 
+#include "collision/content/terrain_generator.h"
 #include "collision/terrain/bitmask_broadphase.h"
-#include "collision/terrain/terrain_generator.h"
 
 namespace bw {
 namespace {

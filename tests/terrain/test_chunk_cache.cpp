@@ -1,12 +1,11 @@
 #include <gtest/gtest.h>
-
 #include <memory>
 
+#include "collision/content/terrain_generator.h"
 #include "collision/terrain/chunk_cache.h"
 #include "collision/terrain/chunk_mesher.h"
 #include "collision/terrain/terrain.h"
 #include "collision/terrain/terrain_queries.h"
-#include "collision/terrain/terrain_generator.h"
 
 namespace bw {
 namespace {

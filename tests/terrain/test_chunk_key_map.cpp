@@ -1,5 +1,4 @@
 #include <gtest/gtest.h>
-
 #include <random>
 #include <unordered_map>
 
@@ -28,7 +27,7 @@ TEST(ChunkKeyMap, MatchesUnorderedMapUnderRandomInsertErase) {
       for (int i = 0; i < 50; ++i) {
         const uint64_t k = chunkKey({int(rng() % 40), int(rng() % 4), int(rng() % 40)});
         const auto it = ref.find(k);
-        EXPECT_EQ(map.find(k), it == ref.end() ? ChunkKeyMap::kNotFound : it->second);
+        EXPECT_EQ(map.find(k), it == ref.end() ? kInvalidIndex : it->second);
       }
     }
   }
@@ -44,11 +43,11 @@ TEST(ChunkKeyMap, KeyRoundTripsAndZeroKeyIsValid) {
   const Int3 c{0x1FFFFF, 12345, 0};
   EXPECT_EQ(chunkCoordFromKey(chunkKey(c)), c);
   ChunkKeyMap map;
-  EXPECT_EQ(map.find(0), ChunkKeyMap::kNotFound);
+  EXPECT_EQ(map.find(0), kInvalidIndex);
   map.insert(chunkKey({0, 0, 0}), 7);
   EXPECT_EQ(map.find(0), 7u);
   EXPECT_TRUE(map.erase(0));
-  EXPECT_EQ(map.find(0), ChunkKeyMap::kNotFound);
+  EXPECT_EQ(map.find(0), kInvalidIndex);
 }
 
 }  // namespace

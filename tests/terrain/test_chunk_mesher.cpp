@@ -1,11 +1,10 @@
-#include <gtest/gtest.h>
-
 #include <cmath>
+#include <gtest/gtest.h>
 #include <map>
 #include <tuple>
 
+#include "collision/content/terrain_generator.h"
 #include "collision/terrain/chunk_mesher.h"
-#include "collision/terrain/terrain_generator.h"
 
 namespace bw {
 namespace {

@@ -1,14 +1,13 @@
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
+#include <gtest/gtest.h>
 #include <limits>
 #include <random>
 #include <vector>
 
+#include "collision/content/terrain_generator.h"
 #include "collision/terrain/chunk_mesher.h"
 #include "collision/terrain/loose_kd_tree.h"
-#include "collision/terrain/terrain_generator.h"
 
 namespace bw {
 namespace {

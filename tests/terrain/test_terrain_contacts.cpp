@@ -1,19 +1,36 @@
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
+#include <gtest/gtest.h>
 #include <memory>
 #include <random>
 #include <vector>
 
-#include "collision/input_validation.h"
+#include "collision/content/terrain_generator.h"
+#include "collision/core/argument_checks.h"
 #include "collision/terrain/chunk_mesher.h"
 #include "collision/terrain/terrain_contacts.h"
 #include "collision/terrain/triangle_contacts.h"
-#include "collision/terrain/terrain_generator.h"
 
 namespace bw {
 namespace {
+
+/// A query shape and where it is (the terrain queries take both).
+struct Placed {
+  QueryShape shape;
+  RigidTransform pose;
+};
+Placed sphereAt(const Vec3d& centre, float radius) { return {QueryShape::sphere(radius), {centre, Quatf::Identity()}}; }
+Placed boxAt(const Vec3d& centre, const Quatf& rotation, const Vec3f& half) { return {QueryShape::box(half), {centre, rotation}}; }
+/// A capsule whose core runs along its local z axis.
+Placed capsuleAt(const Vec3d& centre, const Quatf& rotation, float halfHeight, float radius) {
+  return {QueryShape::capsule(radius, halfHeight), {centre, rotation}};
+}
+size_t terrainContacts(Terrain& terrain, const Placed& p, float spec, std::vector<Contact>& out) {
+  return bw::terrainContacts(terrain, p.shape, p.pose, spec, out);
+}
+bool terrainWaterContact(const Terrain& terrain, const Placed& p, WaterContact& out) {
+  return bw::terrainWaterContact(terrain, p.shape, p.pose, out);
+}
 
 /// A flat solid floor whose top surface is at y = 4 (terrain-local).
 std::unique_ptr<Terrain> flatTerrain(const RigidTransform& place = {}) {
@@ -57,7 +74,7 @@ TEST(TerrainContacts, SphereContactsMatchBruteForceOverAllTriangles) {
     std::vector<float> want;
     for (const Contact& k : brute) want.push_back(k.depth);
     contacts.clear();
-    terrainContacts(terrain, TerrainContactShape::sphere(c.cast<double>(), r), 0.05f, contacts);
+    terrainContacts(terrain, sphereAt(c.cast<double>(), r), 0.05f, contacts);
     std::vector<float> got;
     for (const Contact& k : contacts) got.push_back(k.depth);
     // Duplicate points are merged by terrainContacts; compare the distinct depths and counts.
@@ -85,7 +102,7 @@ TEST(TerrainContacts, SphereOnFlatGroundFarFromOriginAndRotated) {
     const Vec3d localCentre(10.3, 4.0 + 0.5 - 0.1, 12.6);
     const Vec3d centre = p.translation + p.rotation.cast<double>() * localCentre;
     std::vector<Contact> contacts;
-    ASSERT_EQ(terrainContacts(terrain, TerrainContactShape::sphere(centre, 0.5f), 0.f, contacts), 1u);
+    ASSERT_EQ(terrainContacts(terrain, sphereAt(centre, 0.5f), 0.f, contacts), 1u);
     const Contact& c = contacts[0];
     EXPECT_NEAR(c.depth, 0.1f, 1e-4f);
     EXPECT_LT((c.normal - p.directionToWorld(Vec3f(0, 1, 0))).norm(), 1e-5f);
@@ -95,7 +112,7 @@ TEST(TerrainContacts, SphereOnFlatGroundFarFromOriginAndRotated) {
     // Deep: centre 0.2 below the surface, still pushed up along the face normal.
     contacts.clear();
     const Vec3d deep = p.translation + p.rotation.cast<double>() * Vec3d(10.3, 3.8, 12.6);
-    ASSERT_GE(terrainContacts(terrain, TerrainContactShape::sphere(deep, 0.5f), 0.f, contacts), 1u);
+    ASSERT_GE(terrainContacts(terrain, sphereAt(deep, 0.5f), 0.f, contacts), 1u);
     EXPECT_NEAR(contacts[0].depth, 0.7f, 1e-4f);
     EXPECT_LT((contacts[0].normal - p.directionToWorld(Vec3f(0, 1, 0))).norm(), 1e-5f);
   }
@@ -107,13 +124,13 @@ TEST(TerrainContacts, ShapesAcrossChunkBordersGetOneConsistentManifold) {
   std::vector<Contact> contacts;
   // A sphere right above the corner shared by four chunks (x = z = 8): the four chunks' quads
   // all touch it at the same point; exactly one contact survives, along the face normal.
-  terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(8, 4.4, 8), 0.5f), 0.f, contacts);
+  terrainContacts(terrain, sphereAt(Vec3d(8, 4.4, 8), 0.5f), 0.f, contacts);
   ASSERT_EQ(contacts.size(), 1u);
   EXPECT_NEAR(contacts[0].depth, 0.1f, 1e-5f);
   EXPECT_GT(contacts[0].normal.y(), 0.99999f);
   // A box straddling the x = 16 border: its four corners, nothing tilted.
   contacts.clear();
-  terrainContacts(terrain, TerrainContactShape::box(Vec3d(16.1, 4.45, 5.3), Quatf::Identity(), Vec3f(0.7f, 0.5f, 0.4f)), 0.f, contacts);
+  terrainContacts(terrain, boxAt(Vec3d(16.1, 4.45, 5.3), Quatf::Identity(), Vec3f(0.7f, 0.5f, 0.4f)), 0.f, contacts);
   int corners = 0;
   for (const Contact& c : contacts) {
     EXPECT_GT(c.normal.y(), 0.999f);
@@ -130,7 +147,7 @@ TEST(TerrainContacts, SphereOnAStepEdgeGetsADiagonalNormal) {
   std::vector<Contact> contacts;
   // Centre beyond the step's edge line (x = 10, y = 5), diagonally out, 0.05 penetrating.
   const double off = (0.5 - 0.05) / std::sqrt(2.0);
-  terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(10 + off, 5 + off, 15.5), 0.5f), 0.f, contacts);
+  terrainContacts(terrain, sphereAt(Vec3d(10 + off, 5 + off, 15.5), 0.5f), 0.f, contacts);
   ASSERT_FALSE(contacts.empty());
   float deepest = 0.f;
   for (const Contact& c : contacts) deepest = std::max(deepest, c.depth);
@@ -143,7 +160,7 @@ TEST(TerrainContacts, BoxRestingOnGroundIsSupportedAtItsFourCorners) {
   const auto holder = flatTerrain();
   Terrain& terrain = *holder;
   std::vector<Contact> contacts;
-  terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.5 - 0.05, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)), 0.f,
+  terrainContacts(terrain, boxAt(Vec3d(10.3, 4.5 - 0.05, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)), 0.f,
                   contacts);
   ASSERT_GE(contacts.size(), 4u);
   int corners = 0;
@@ -159,17 +176,17 @@ TEST(TerrainContacts, BoxRestingOnGroundIsSupportedAtItsFourCorners) {
   contacts.clear();
   const Quatf tilt(Eigen::AngleAxisf(float(M_PI / 4), Vec3f::UnitZ()));
   const double h = 0.5 * std::sqrt(2.0);
-  terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.0 + h - 0.05, 10.4), tilt, Vec3f(0.5f, 0.5f, 0.5f)), 0.f, contacts);
+  terrainContacts(terrain, boxAt(Vec3d(10.3, 4.0 + h - 0.05, 10.4), tilt, Vec3f(0.5f, 0.5f, 0.5f)), 0.f, contacts);
   ASSERT_FALSE(contacts.empty());
   float deepest = 0.f;
   for (const Contact& c : contacts) deepest = std::max(deepest, c.depth);
   EXPECT_NEAR(deepest, 0.05f, 1e-3f);
   // Out of reach: nothing; within the speculative distance: negative depth.
   contacts.clear();
-  EXPECT_EQ(terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.6, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)), 0.f,
+  EXPECT_EQ(terrainContacts(terrain, boxAt(Vec3d(10.3, 4.6, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)), 0.f,
                             contacts),
             0u);
-  EXPECT_GE(terrainContacts(terrain, TerrainContactShape::box(Vec3d(10.3, 4.6, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)),
+  EXPECT_GE(terrainContacts(terrain, boxAt(Vec3d(10.3, 4.6, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f)),
                             0.2f, contacts),
             1u);
   EXPECT_NEAR(contacts[0].depth, -0.1f, 1e-3f);
@@ -179,8 +196,8 @@ TEST(TerrainContacts, CapsuleLyingFlatTouchesAtBothEnds) {
   const auto holder = flatTerrain();
   Terrain& terrain = *holder;
   std::vector<Contact> contacts;
-  const Quatf lying(Eigen::AngleAxisf(float(M_PI / 2), Vec3f::UnitZ()));  // core along X
-  terrainContacts(terrain, TerrainContactShape::capsule(Vec3d(12.2, 4.0 + 0.3 - 0.02, 9.7), lying, 1.0f, 0.3f), 0.f, contacts);
+  const Quatf lying(Eigen::AngleAxisf(float(M_PI / 2), Vec3f::UnitY()));  // core (local z) along X
+  terrainContacts(terrain, capsuleAt(Vec3d(12.2, 4.0 + 0.3 - 0.02, 9.7), lying, 1.0f, 0.3f), 0.f, contacts);
   ASSERT_GE(contacts.size(), 2u);
   bool left = false, right = false;
   for (const Contact& c : contacts) {
@@ -197,18 +214,18 @@ TEST(TerrainContacts, ConvexHullAgreesWithTheEquivalentBox) {
   const std::vector<Vec3f> pts = {{-0.4f, -0.3f, -0.2f}, {0.4f, -0.3f, -0.2f}, {-0.4f, 0.3f, -0.2f}, {0.4f, 0.3f, -0.2f},
                                   {-0.4f, -0.3f, 0.2f},  {0.4f, -0.3f, 0.2f},  {-0.4f, 0.3f, 0.2f},  {0.4f, 0.3f, 0.2f},
                                   {0.f, 0.f, 0.f}};
-  const TerrainContactShape hull = TerrainContactShape::convexHull(Vec3d(5.5, 4.25, 6.5), Quatf::Identity(), pts.data(), uint32_t(pts.size()));
-  EXPECT_NEAR(hull.volume(), 0.8f * 0.6f * 0.4f, 1e-5f);
+  const Placed hull{QueryShape::hull(pts.data(), uint32_t(pts.size())), {Vec3d(5.5, 4.25, 6.5), Quatf::Identity()}};
+  EXPECT_NEAR(hull.shape.volume(), 0.8f * 0.6f * 0.4f, 1e-5f);
   std::vector<Contact> h, b;
   terrainContacts(terrain, hull, 0.f, h);
-  terrainContacts(terrain, TerrainContactShape::box(Vec3d(5.5, 4.25, 6.5), Quatf::Identity(), Vec3f(0.4f, 0.3f, 0.2f)), 0.f, b);
+  terrainContacts(terrain, boxAt(Vec3d(5.5, 4.25, 6.5), Quatf::Identity(), Vec3f(0.4f, 0.3f, 0.2f)), 0.f, b);
   ASSERT_FALSE(h.empty());
   ASSERT_EQ(h.size(), b.size());
   for (size_t i = 0; i < h.size(); ++i) {
     EXPECT_NEAR(h[i].depth, b[i].depth, 1e-4f);
     EXPECT_NEAR(h[i].depth, 0.05f, 1e-4f);
   }
-  EXPECT_THROW(TerrainContactShape::convexHull(Vec3d::Zero(), Quatf::Identity(), pts.data(), 3), InvalidInput);
+  EXPECT_THROW(terrainContacts(terrain, Placed{QueryShape::hull(pts.data(), 3), {}}, 0.f, h), InvalidInput);
 }
 
 TEST(TerrainContacts, WaterGivesSubmergedVolumeForBuoyancy) {
@@ -217,34 +234,34 @@ TEST(TerrainContacts, WaterGivesSubmergedVolumeForBuoyancy) {
   terrain.fillBox({0, 4, 0}, {31, 7, 31}, Voxel::make(kMaterialWater));  // water surface at y = 8
   WaterContact w;
   // Box with half its height under the surface.
-  const TerrainContactShape box = TerrainContactShape::box(Vec3d(10, 8, 10), Quatf::Identity(), Vec3f(1, 0.5f, 1));
+  const Placed box = boxAt(Vec3d(10, 8, 10), Quatf::Identity(), Vec3f(1, 0.5f, 1));
   ASSERT_TRUE(terrainWaterContact(terrain, box, w));
   EXPECT_NEAR(w.submergedVolume, 2.0, 1e-4);
   EXPECT_NEAR(w.submergedFraction, 0.5f, 1e-5f);
   EXPECT_NEAR(w.centreOfBuoyancy.y(), 7.75, 1e-4);
   // Fully submerged sphere: the whole volume.
-  ASSERT_TRUE(terrainWaterContact(terrain, TerrainContactShape::sphere(Vec3d(10, 6, 10), 0.7f), w));
+  ASSERT_TRUE(terrainWaterContact(terrain, sphereAt(Vec3d(10, 6, 10), 0.7f), w));
   EXPECT_NEAR(w.submergedVolume, 4.0 / 3.0 * M_PI * 0.343, 1e-3);
   EXPECT_NEAR(w.submergedFraction, 1.f, 1e-6f);
   // Partly filled water cells (occupancy 51/255 = 0.2 of a cell): water ends at y = 7.2.
   terrain.fillBox({0, 7, 0}, {31, 7, 31}, Voxel::make(kMaterialWater, 51));
-  const TerrainContactShape low = TerrainContactShape::box(Vec3d(10, 7.4, 10), Quatf::Identity(), Vec3f(1, 0.5f, 1));
+  const Placed low = boxAt(Vec3d(10, 7.4, 10), Quatf::Identity(), Vec3f(1, 0.5f, 1));
   ASSERT_TRUE(terrainWaterContact(terrain, low, w));
   EXPECT_NEAR(w.submergedVolume, 4.0 * 0.3, 1e-4);  // from y = 6.9 to 7.2
   EXPECT_FALSE(terrainWaterContact(terrain, box, w));  // box bottom 7.5 is above the water
   // In the air above the water: nothing.
-  EXPECT_FALSE(terrainWaterContact(terrain, TerrainContactShape::sphere(Vec3d(10, 13, 10), 0.5f), w));
+  EXPECT_FALSE(terrainWaterContact(terrain, sphereAt(Vec3d(10, 13, 10), 0.5f), w));
 }
 
 TEST(TerrainContacts, RejectsInvalidShapes) {
   const auto holder = flatTerrain();
   Terrain& terrain = *holder;
   std::vector<Contact> contacts;
-  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(NAN, 0, 0), 1.f), 0.f, contacts), InvalidInput);
-  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(0, 0, 0), -1.f), 0.f, contacts), InvalidInput);
-  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::box(Vec3d(0, 0, 0), Quatf(2, 0, 0, 0), Vec3f(1, 1, 1)), 0.f, contacts),
+  EXPECT_THROW(terrainContacts(terrain, sphereAt(Vec3d(NAN, 0, 0), 1.f), 0.f, contacts), InvalidInput);
+  EXPECT_THROW(terrainContacts(terrain, sphereAt(Vec3d(0, 0, 0), -1.f), 0.f, contacts), InvalidInput);
+  EXPECT_THROW(terrainContacts(terrain, boxAt(Vec3d(0, 0, 0), Quatf(2, 0, 0, 0), Vec3f(1, 1, 1)), 0.f, contacts),
                InvalidInput);
-  EXPECT_THROW(terrainContacts(terrain, TerrainContactShape::sphere(Vec3d(0, 0, 0), 1.f), NAN, contacts), InvalidInput);
+  EXPECT_THROW(terrainContacts(terrain, sphereAt(Vec3d(0, 0, 0), 1.f), NAN, contacts), InvalidInput);
 }
 
 }  // namespace

@@ -1,15 +1,14 @@
-#include <gtest/gtest.h>
-
 #include <cmath>
+#include <gtest/gtest.h>
 #include <limits>
 #include <random>
 #include <vector>
 
-#include "collision/input_validation.h"
+#include "collision/content/terrain_generator.h"
+#include "collision/core/argument_checks.h"
 #include "collision/terrain/chunk_mesher.h"
 #include "collision/terrain/ray_triangle.h"
 #include "collision/terrain/terrain_queries.h"
-#include "collision/terrain/terrain_generator.h"
 
 namespace bw {
 namespace {

@@ -2,8 +2,6 @@
 // against a separate minimal chunk scan written here), against hand-built files (scene-graph
 // placement, palettes, material mapping, terrain round trips) and against bad files: each must
 // fail with InvalidInput naming the file, never crash or half-load.
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -11,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <map>
 #include <random>
 #include <sstream>
@@ -18,9 +17,9 @@
 #include <utility>
 #include <vector>
 
-#include "collision/input_validation.h"
+#include "collision/content/vox_reader.h"
+#include "collision/core/argument_checks.h"
 #include "collision/terrain/terrain.h"
-#include "collision/terrain/vox_reader.h"
 
 namespace bw {
 namespace {

@@ -1,10 +1,9 @@
 // AttachmentStore: input validation, render ids, hierarchy levels.
-#include <gtest/gtest.h>
-
 #include <cmath>
+#include <gtest/gtest.h>
 #include <limits>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 #include "transforms/attachment_store.h"
 #include "transforms/attachment_workload.h"
 
@@ -15,10 +14,10 @@ const Aabb kBox = Aabb::fromCenterHalf(Vec3f::Zero(), Vec3f::Constant(1.f));
 
 TEST(AttachmentStore, AssignsRenderIdsPerKindInCreationOrder) {
   AttachmentStore s;
-  const uint32_t a = s.addPrimitive(0, kNoParentAttachment, Vec3f::Zero(), Quatf::Identity(), kBox);
+  const uint32_t a = s.addPrimitive(0, kInvalidIndex, Vec3f::Zero(), Quatf::Identity(), kBox);
   const uint32_t b = s.addLight(0, a, Vec3f::UnitX(), Quatf::Identity(), 5.f);
-  const uint32_t c = s.addPrimitive(1, kNoParentAttachment, Vec3f::Zero(), Quatf::Identity(), kBox);
-  const uint32_t d = s.addLight(1, kNoParentAttachment, Vec3f::Zero(), Quatf::Identity(), 7.f);
+  const uint32_t c = s.addPrimitive(1, kInvalidIndex, Vec3f::Zero(), Quatf::Identity(), kBox);
+  const uint32_t d = s.addLight(1, kInvalidIndex, Vec3f::Zero(), Quatf::Identity(), 7.f);
   EXPECT_EQ(s.renderId(a), 0u);
   EXPECT_EQ(s.renderId(c), 1u);
   EXPECT_EQ(s.renderId(b), 0u);
@@ -32,7 +31,7 @@ TEST(AttachmentStore, AssignsRenderIdsPerKindInCreationOrder) {
 
 TEST(AttachmentStore, RejectsBadInputWithoutStoringIt) {
   AttachmentStore s;
-  const uint32_t root = s.addPrimitive(3, kNoParentAttachment, Vec3f::Zero(), Quatf::Identity(), kBox);
+  const uint32_t root = s.addPrimitive(3, kInvalidIndex, Vec3f::Zero(), Quatf::Identity(), kBox);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   EXPECT_THROW(s.addPrimitive(3, 7, Vec3f::Zero(), Quatf::Identity(), kBox), InvalidInput);      // no such parent
   EXPECT_THROW(s.addPrimitive(4, root, Vec3f::Zero(), Quatf::Identity(), kBox), InvalidInput);   // other body
@@ -48,7 +47,7 @@ TEST(AttachmentStore, RejectsBadInputWithoutStoringIt) {
 
 TEST(AttachmentStore, LimitsHierarchyDepth) {
   AttachmentStore s;
-  uint32_t parent = kNoParentAttachment;
+  uint32_t parent = kInvalidIndex;
   for (uint32_t d = 0; d < kMaxAttachmentDepth; ++d)
     parent = s.addPrimitive(0, parent, Vec3f::UnitX(), Quatf::Identity(), kBox);
   EXPECT_EQ(s.depth(parent), kMaxAttachmentDepth - 1);
@@ -76,7 +75,7 @@ TEST(AttachmentStore, LevelOrderPutsParentsInEarlierLevels) {
     }
   for (uint32_t id = 0; id < s.size(); ++id) {
     EXPECT_EQ(seen[id], 1u);
-    if (s.parent(id) != kNoParentAttachment) {
+    if (s.parent(id) != kInvalidIndex) {
       EXPECT_LT(levelOf[s.parent(id)], levelOf[id]);
     }
   }

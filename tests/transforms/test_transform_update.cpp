@@ -1,12 +1,11 @@
 // TransformUpdate (SoA, parallel) against an independent serial reference and against the
 // object-style baseline: same world poses, same records, only for attachments that moved.
 #include <gtest/gtest.h>
-
 #include <ostream>
 #include <random>
 #include <string>
 
-#include "collision/input_validation.h"
+#include "collision/core/argument_checks.h"
 #include "jobs/job_system.h"
 #include "transforms/attachment_math.h"
 #include "transforms/attachment_workload.h"
@@ -33,7 +32,7 @@ struct Reference {
     previousRotation = rotation;
     for (uint32_t id = 0; id < s.size(); ++id) {
       std::vector<uint32_t> chain;  // id, parent, grandparent, ...
-      for (uint32_t a = id; a != kNoParentAttachment; a = s.parent(a)) chain.push_back(a);
+      for (uint32_t a = id; a != kInvalidIndex; a = s.parent(a)) chain.push_back(a);
       const uint32_t body = s.body(id);
       bool m = bodies.moved[body] != 0;
       Vec3d t = bodies.position[body];
@@ -182,7 +181,7 @@ TEST(TransformUpdate, ObjectStyleBaselineProducesIdenticalRecords) {
 TEST(TransformUpdate, LocalOffsetEditRecomputesOnlyThatSubtree) {
   AttachmentStore s;
   const Aabb box = Aabb::fromCenterHalf(Vec3f::Zero(), Vec3f::Ones());
-  const uint32_t hull = s.addPrimitive(0, kNoParentAttachment, Vec3f::Zero(), Quatf::Identity(), box);
+  const uint32_t hull = s.addPrimitive(0, kInvalidIndex, Vec3f::Zero(), Quatf::Identity(), box);
   const uint32_t lamp = s.addLight(0, hull, Vec3f(0, 2, 0), Quatf::Identity(), 4.f);
   const uint32_t lens = s.addPrimitive(0, lamp, Vec3f(0, 0.5f, 0), Quatf::Identity(), box);
   const uint32_t other = s.addPrimitive(0, hull, Vec3f(1, 0, 0), Quatf::Identity(), box);
@@ -217,7 +216,7 @@ TEST(TransformUpdate, LocalOffsetEditRecomputesOnlyThatSubtree) {
 
 TEST(TransformUpdate, KeepsPrecisionFarFromTheOrigin) {
   AttachmentStore s;
-  const uint32_t a = s.addPrimitive(0, kNoParentAttachment, Vec3f(0.001f, 0.002f, 0.003f), Quatf::Identity(),
+  const uint32_t a = s.addPrimitive(0, kInvalidIndex, Vec3f(0.001f, 0.002f, 0.003f), Quatf::Identity(),
                                     Aabb::fromCenterHalf(Vec3f::Zero(), Vec3f::Ones()));
   const Vec3d position[1] = {Vec3d(1e7, -2e7, 3e7)};
   const Quatf rotation[1] = {Quatf::Identity()};
@@ -232,7 +231,7 @@ TEST(TransformUpdate, KeepsPrecisionFarFromTheOrigin) {
 
 TEST(TransformUpdate, RejectsABodyViewThatDoesNotCoverTheStore) {
   AttachmentStore s;
-  s.addPrimitive(5, kNoParentAttachment, Vec3f::Zero(), Quatf::Identity(),
+  s.addPrimitive(5, kInvalidIndex, Vec3f::Zero(), Quatf::Identity(),
                  Aabb::fromCenterHalf(Vec3f::Zero(), Vec3f::Ones()));
   const Vec3d position[2] = {Vec3d::Zero(), Vec3d::Zero()};
   const Quatf rotation[2] = {Quatf::Identity(), Quatf::Identity()};

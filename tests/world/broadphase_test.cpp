@@ -1,11 +1,10 @@
 // Sweep and prune against brute force over all pairs: random, clustered and far-from-origin
 // bodies, moving frame to frame, with static bodies that must never pair with each other.
-#include "world/broadphase.h"
-
 #include <gtest/gtest.h>
 
-#include "collision/input_validation.h"
-#include "collision/seeded_random.h"
+#include "collision/core/argument_checks.h"
+#include "collision/core/seeded_random.h"
+#include "world/broadphase.h"
 
 namespace bw {
 namespace {

@@ -3,12 +3,11 @@
 // step gets contacts out to that gap, and the solver lets the gap close but not cross. These
 // tests fire bodies far faster than their size per step at thin targets, from seeded random
 // positions, orientations and directions, and demand that every run stays on the near side.
-#include <gtest/gtest.h>
-
 #include <cmath>
+#include <gtest/gtest.h>
 #include <string>
 
-#include "collision/seeded_random.h"
+#include "collision/core/seeded_random.h"
 #include "world/scene_file.h"
 #include "world/world.h"
 

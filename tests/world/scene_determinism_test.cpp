@@ -1,9 +1,8 @@
 // Every shipped scene ends in the same state for 1, 2, 4 and 16 threads and from run to run
 // (a short run of each: long enough for contacts, islands and sleeping to kick in).
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <filesystem>
+#include <gtest/gtest.h>
 
 #include "world/scene_file.h"
 #include "world/world.h"

@@ -1,13 +1,11 @@
 // Scene files: a valid scene parses completely; every kind of bad value fails with a message
 // naming the file, the field and what was expected; the shipped scenes all parse.
-#include "world/scene_file.h"
-
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <functional>
+#include <gtest/gtest.h>
 #include <limits>
 
+#include "world/scene_file.h"
 #include "world/world.h"
 
 namespace bw {

@@ -1,11 +1,10 @@
 // The world on real content and its tools: a Brickadia save as a static grid (and tiled), a
 // MagicaVoxel model as terrain with water, bad content files named in a scene, contact probes
 // that leave the state alone, grid edits between steps, and the ten-box stack's drift goal.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <gtest/gtest.h>
 #include <iterator>
 
 #include "world/scene_file.h"

@@ -4,11 +4,10 @@
 // code or parsed from JSON here, seeded, and stepped on one thread (the state does not depend on
 // the thread count; world_test checks that). Measured figures are printed so a regression shows
 // how far it moved, not only that it failed.
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <gtest/gtest.h>
 #include <string>
 #include <utility>
 #include <vector>

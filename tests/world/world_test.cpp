@@ -1,10 +1,9 @@
 // World: bodies come to rest on grids at the right height, stacks stand, kinematic grids follow
 // their script, and the final state is bit-identical for 1, 2, 4 and 16 threads.
-#include "world/world.h"
-
 #include <gtest/gtest.h>
 
 #include "world/scene_file.h"
+#include "world/world.h"
 
 namespace bw {
 namespace {

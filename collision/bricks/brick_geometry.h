@@ -1,0 +1,60 @@
+#pragma once
+/// Exact geometry of brick shapes: vertices, face planes, bounds, mass moments, ray clipping.
+/// Canonical shapes are described in brick.h; everything here is exact for every shape and
+/// rotation (rotations are signed permutations).
+#include <cstdint>
+
+#include "collision/bricks/brick.h"
+#include "collision/core/ray.h"
+
+namespace bw {
+
+constexpr int kMaxBrickVertices = 128;  ///< a 64-sided cylinder
+constexpr int kMaxBrickPlanes = 66;
+
+/// Plane n . x <= d bounding a brick's canonical shape (n unit length).
+struct BrickPlane {
+  Vec3f n;
+  float d;
+};
+
+/// Vertices of the canonical (unrotated, centred) shape. Returns the count.
+int canonicalBrickVertices(const Brick& b, Vec3f* out);
+/// Face planes of the canonical shape (the shape is their intersection). Returns the count.
+int canonicalBrickPlanes(const Brick& b, BrickPlane* out);
+/// Vertices in the grid frame (rotated and placed). Returns the count.
+int brickVertices(const Brick& b, Vec3f* out);
+/// Exact grid-local bounds of the brick's shape.
+Aabb brickBounds(const Brick& b);
+
+/// Volume-weighted moments of a shape at density 1: volume, first moment (volume x centroid)
+/// and second moment (integral of x x^T), all in the frame they were computed in.
+struct ShapeMoments {
+  double volume = 0;
+  Vec3d first = Vec3d::Zero();
+  Mat3d second = Mat3d::Zero();
+  void operator+=(const ShapeMoments& o) {
+    volume += o.volume;
+    first += o.first;
+    second += o.second;
+  }
+  void operator-=(const ShapeMoments& o) {
+    volume -= o.volume;
+    first -= o.first;
+    second -= o.second;
+  }
+};
+/// Moments of the canonical shape (about its box centre, unrotated).
+ShapeMoments canonicalBrickMoments(const Brick& b);
+/// Moments of the placed brick about `reference` in the grid frame, scaled by density.
+ShapeMoments brickMoments(const Brick& b, double density, const Vec3d& reference);
+
+/// Exact ray/brick-shape intersection in the grid frame: entry t within [0, tMax] and the
+/// outward normal of the entered face (grid frame). A ray starting inside reports t = 0 and the
+/// normal opposing the ray direction.
+bool rayBrick(const Brick& b, const Ray& gridRay, float tMax, float& t, Vec3f& normal);
+
+/// True when point p (grid frame) is inside the brick's shape (closed).
+bool brickContains(const Brick& b, const Vec3f& p, float tolerance = 0.f);
+
+}  // namespace bw

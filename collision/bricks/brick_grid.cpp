@@ -1,0 +1,201 @@
+#include "collision/bricks/brick_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "collision/core/argument_checks.h"
+
+namespace bw {
+
+// A few ulps of the largest coordinate a ray or sweep query involves (the grid's bounds and the
+// query's own point): covers the rounding differences between slab tests and exact shape tests.
+float BrickGrid::roundingMargin(const Vec3f& queryPoint) const {
+  const Aabb all = index_.rootBounds();
+  float reach = queryPoint.cwiseAbs().maxCoeff();
+  if (!all.isEmpty()) reach = std::max({reach, all.min.cwiseAbs().maxCoeff(), all.max.cwiseAbs().maxCoeff()});
+  return reach * 0x1p-20f + std::numeric_limits<float>::min();
+}
+
+BrickGrid::BrickGrid(const Config& config)
+    : config_(config),
+      bricks_(config.maxBricks, "BrickGrid bricks"),
+      index_(OctoBvh::Config{config.maxBricks}) {
+  for (float d : config.density)
+    if (!(d > 0.f) || !std::isfinite(d)) throw InvalidInput("BrickGrid: every material density must be finite and > 0");
+}
+
+uint32_t BrickGrid::placeBrick(const Brick& b) {
+  validateBrick(b, "BrickGrid::placeBrick");
+  const Aabb box = brickBounds(b);
+  const uint32_t id = bricks_.allocate();
+  uint32_t element;
+  try {
+    element = index_.insert(box, b.filter, id);  // validates range; throws before modifying
+  } catch (...) {
+    bricks_.free(id);
+    throw;
+  }
+  bricks_.get<0>(id) = b;
+  bricks_.get<1>(id) = element;
+  if (!referenceSet_) {
+    // note: moments are summed about the first brick's position, not the grid origin, so a grid
+    // built far from its origin does not lose its inertia to cancellation in double.
+    reference_ = b.position.cast<double>();
+    referenceSet_ = true;
+  }
+  moments_ += brickMoments(b, config_.density[b.material], reference_);
+  ++edits_;
+  return id;
+}
+
+void BrickGrid::removeBrick(uint32_t id) {
+  if (!bricks_.isLive(id))
+    throw InvalidInput("BrickGrid::removeBrick: brick " + std::to_string(id) + " is not in this grid");
+  const Brick b = bricks_.get<0>(id);
+  index_.remove(bricks_.get<1>(id));
+  bricks_.free(id);
+  if (bricks_.size() == 0) {
+    moments_ = {};  // exactly empty, no accumulated rounding
+    referenceSet_ = false;
+  } else {
+    moments_ -= brickMoments(b, config_.density[b.material], reference_);
+  }
+  ++edits_;
+}
+
+MassProperties BrickGrid::massProperties() const {
+  MassProperties m;
+  if (bricks_.size() == 0 || moments_.volume <= 0) return m;
+  m.mass = moments_.volume;
+  const Vec3d comRel = moments_.first / m.mass;
+  const Mat3d c = moments_.second - m.mass * comRel * comRel.transpose();
+  m.inertia = c.trace() * Mat3d::Identity() - c;
+  m.centerOfMass = reference_ + comRel;
+  return m;
+}
+
+GridRayHit BrickGrid::raycast(const Ray& ray, uint32_t mask, QueryStats* stats) const {
+  requireFinite(ray.origin, "BrickGrid::raycast", "ray.origin");
+  requireFinite(ray.dir, "BrickGrid::raycast", "ray.dir");
+  if (ray.parallelMask == 7)
+    throw InvalidInput("BrickGrid::raycast: ray.dir has zero length (every component is zero or denormal)");
+  if (!(ray.maxT >= 0.f))
+    throw InvalidInput("BrickGrid::raycast: ray.maxT is " + std::to_string(ray.maxT) + ", expected >= 0 (+inf: unlimited)");
+  // note: the index's slab tests (bounds times 1/dir) and rayBrick (plane distances divided in the
+  // brick's frame) round differently, so by one ulp the index could reject a brick the ray only
+  // grazes, or whose exact entry ties the best hit. Traversing bounds grown by a few ulps of the
+  // largest coordinate involved keeps the index conservative: every brick rayBrick hits within
+  // maxT is tested, so the result is rayBrick's smallest t, ties going to the lowest handle.
+  const RayHit h = index_.sweepClosest(ray, Vec3f::Constant(roundingMargin(ray.origin)), mask,
+                                       [&](uint32_t e, float, float tMax, float& tHit) {
+                                         Vec3f n;
+                                         return rayBrick(brick(index_.payload(e)), ray, tMax, tHit, n);
+                                       },
+                                       stats);
+  GridRayHit out;
+  if (!h.hit()) return out;
+  out.brick = index_.payload(h.element);
+  float t;
+  rayBrick(brick(out.brick), ray, ray.maxT, t, out.normal);
+  out.t = h.t;
+  return out;
+}
+
+GridSweepHit BrickGrid::sweep(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to,
+                              uint32_t mask, QueryStats* stats) const {
+  shape.validate("BrickGrid::sweep");
+  requireFinite(from, "BrickGrid::sweep", "from");
+  requireFinite(to, "BrickGrid::sweep", "to");
+  requireUnitQuaternion(rotation, "BrickGrid::sweep", "rotation");
+  // note: sweepShapeBrick stops within its gap tolerance (1e-4 x (1 + brick half size)) of first
+  // touch, possibly earlier in t than where the bounds meet; growing the traversed bounds by the
+  // largest such tolerance (bounded by half the grid's extent) and a rounding margin keeps the
+  // index conservative, so the result is the smallest fraction over every brick.
+  const float tolerance = 1e-4f * (1.f + 0.5f * index_.rootBounds().extent().cwiseMax(0.f).maxCoeff());
+  const Vec3f grow = rotation.toRotationMatrix().cwiseAbs() * shape.localHalfExtents() +
+                     Vec3f::Constant(tolerance + roundingMargin(from));
+  const Ray ray = Ray::make(from, to - from, 1.f);
+  GridSweepHit out;
+  const RayHit h = index_.sweepClosest(ray, grow, mask,
+                                       [&](uint32_t e, float, float tMax, float& tHit) {
+                                         float f;
+                                         Vec3f n, p;
+                                         if (!sweepShapeBrick(shape, rotation, from, to, brick(index_.payload(e)), f, n, p)) return false;
+                                         tHit = f;
+                                         return f <= tMax;
+                                       },
+                                       stats);
+  if (!h.hit()) return out;
+  out.brick = index_.payload(h.element);
+  sweepShapeBrick(shape, rotation, from, to, brick(out.brick), out.fraction, out.normal, out.point);
+  return out;
+}
+
+void BrickGrid::overlapBricks(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats) const {
+  // note: infinite bounds are accepted (an unbounded box, or Aabb::empty()); NaN would silently
+  // overlap nothing.
+  for (int i = 0; i < 3; ++i) {
+    if (std::isnan(box.min[i])) throw InvalidInput(std::string("BrickGrid::overlapBricks: box.min.") + "xyz"[i] + " is NaN");
+    if (std::isnan(box.max[i])) throw InvalidInput(std::string("BrickGrid::overlapBricks: box.max.") + "xyz"[i] + " is NaN");
+  }
+  index_.overlap(box, mask, [&](uint32_t e) { out.push_back(index_.payload(e)); }, stats);
+}
+
+void BrickGrid::collideLocal(const QueryShape& shape, const LocalPose& pose, const ContactParams& params,
+                             std::vector<LocalContact>& out, ContactStats* stats) const {
+  const Mat3f R = pose.rotation.toRotationMatrix();
+  const Vec3f e = R.cwiseAbs() * shape.localHalfExtents() + Vec3f::Constant(std::max(params.speculativeMargin, 0.f));
+  const Aabb box{pose.position - e, pose.position + e};
+  ContactStats local;
+  LocalContact buf[kMaxContactsPerBrick];
+  auto onBrick = [&](uint32_t element) {
+    const uint32_t id = index_.payload(element);
+    ++local.bricksTested;
+    const int n = collideShapeBrick(shape, pose, brick(id), id, params.speculativeMargin, buf);
+    out.insert(out.end(), buf, buf + n);
+  };
+  auto onLod = [&](const LodBox& lod) {
+    // A small subtree collides as one solid box of its tight bounds.
+    Brick b;
+    b.position = lod.bounds.center();
+    b.halfSize = lod.bounds.halfExtent().cwiseMax(Vec3f::Constant(kMinBrickHalfSize));
+    b.shape = BrickShape::Box;
+    const int n = collideShapeBrick(shape, pose, b, kLodFeature | local.lodBoxes, params.speculativeMargin, buf);
+    ++local.lodBoxes;
+    out.insert(out.end(), buf, buf + n);
+  };
+  const size_t before = out.size();
+  index_.overlapLod(box, params.mask, params.lodFraction, onBrick, onLod, &local.index);
+  local.rawContacts = uint32_t(out.size() - before);
+  if (stats) {
+    stats->index += local.index;
+    stats->bricksTested += local.bricksTested;
+    stats->lodBoxes += local.lodBoxes;
+    stats->rawContacts += local.rawContacts;
+  }
+}
+
+size_t BrickGrid::collide(const RigidTransform& gridPose, const QueryShape& shape, const RigidTransform& shapePose,
+                          const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out,
+                          ContactStats* stats) const {
+  gridPose.validate("BrickGrid::collide (grid pose)");
+  shapePose.validate("BrickGrid::collide (shape pose)");
+  shape.validate("BrickGrid::collide");
+  if (params.maxContacts < 1 || params.maxContacts > 64)
+    throw InvalidInput("BrickGrid::collide: params.maxContacts is " + std::to_string(params.maxContacts) + ", expected 1..64");
+  requireInRange(params.lodFraction, 0.0, 1.0, "BrickGrid::collide", "params.lodFraction");
+  requireFinite(params.speculativeMargin, "BrickGrid::collide", "params.speculativeMargin");
+  const LocalPose pose{gridPose.pointToLocal(shapePose.translation), gridPose.rotationToLocal(shapePose.rotation).normalized()};
+  scratch.raw.clear();
+  collideLocal(shape, pose, params, scratch.raw, stats);
+  const int n = reduceManifold(scratch.raw.data(), int(scratch.raw.size()), params.maxContacts);
+  for (int i = 0; i < n; ++i) {
+    const LocalContact& c = scratch.raw[i];
+    out.push_back({gridPose.pointToWorld(c.position), gridPose.directionToWorld(c.normal), c.depth, c.feature, c.material});
+  }
+  return size_t(n);
+}
+
+}  // namespace bw

@@ -1,0 +1,180 @@
+#pragma once
+/// A brick grid: bricks in a virtual pool, an OctoBVH over their exact bounds, and mass
+/// properties kept up to date as bricks are placed and removed (no global rebuild, ever).
+///
+///   bw::BrickGrid grid;
+///   uint32_t id = grid.placeBrick(brick);             // validates, indexes, adds mass
+///   bw::GridRayHit hit = grid.raycast(localRay, ~0u);   // exact brick shapes
+///   grid.collide(gridPose, shape, shapePose, params, scratch, contacts);
+///   grid.removeBrick(id);
+///
+/// Everything inside is float in the grid's local frame; poses and contacts at the API are
+/// world-space (double positions) and converted through RigidTransform only.
+/// Thread safety: const queries may run concurrently; placeBrick/removeBrick and
+/// convexApproximation() (which refreshes a cache) need exclusive access.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "collision/bricks/brick.h"
+#include "collision/bricks/brick_geometry.h"
+#include "collision/bricks/brick_narrowphase.h"
+#include "collision/bricks/contact.h"
+#include "collision/core/ids.h"
+#include "collision/core/rigid_transform.h"
+#include "collision/index/octobvh.h"
+
+namespace bw {
+
+/// Mass, centre of mass (grid frame) and inertia tensor about the centre of mass (grid axes).
+struct MassProperties {
+  double mass = 0;
+  Vec3d centerOfMass = Vec3d::Zero();
+  Mat3d inertia = Mat3d::Zero();
+};
+
+/// A raycast hit on a brick's real shape (grid frame).
+struct GridRayHit {
+  uint32_t brick = kInvalidIndex;
+  float t = 0;
+  Vec3f normal = Vec3f::Zero();
+  bool hit() const { return brick != kInvalidIndex; }
+};
+
+/// A sweep hit: first time of impact as a fraction of the motion, on the brick's real shape.
+struct GridSweepHit {
+  uint32_t brick = kInvalidIndex;
+  float fraction = 1.f;          ///< 0..1 of the motion from -> to
+  Vec3f normal = Vec3f::Zero();  ///< from the brick towards the shape
+  Vec3f point = Vec3f::Zero();   ///< on the brick
+  bool hit() const { return brick != kInvalidIndex; }
+};
+
+/// Knobs of a contact query.
+struct ContactParams {
+  uint32_t mask = 0xFFFFFFFFu;    ///< filter mask against brick filter bits
+  float lodFraction = 1.f / 16;   ///< subtrees smaller than this x shape size are solid boxes (0: off)
+  float speculativeMargin = 0.f;  ///< also report gaps below this (negative depth)
+  int maxContacts = 4;            ///< manifold size after reduction (1..64)
+};
+
+/// Counters of one contact query.
+struct ContactStats {
+  QueryStats index;
+  uint32_t bricksTested = 0;   ///< narrowphase calls on bricks
+  uint32_t lodBoxes = 0;       ///< subtrees collided as one box
+  uint32_t rawContacts = 0;    ///< before manifold reduction
+};
+
+/// Reusable buffers for contact queries (one per thread): no allocation once warmed up.
+struct ContactScratch {
+  std::vector<LocalContact> raw;
+};
+
+/// A grid's convex stand-in for grid-vs-grid collision (grid frame).
+struct ConvexApproximation {
+  bool isBox = false;             ///< the hull was exactly its bounding box
+  Aabb bounds = Aabb::empty();
+  std::vector<Vec3f> vertices;    ///< hull vertices (the 8 corners when isBox)
+  std::vector<Vec3f> centered;    ///< the same relative to shapeCenter(), for shape()
+  double hullVolume = 0;
+  int depth = 0;
+  uint32_t inputPoints = 0;       ///< points handed to the hull computer
+  QueryShape shape() const;       ///< as a query shape (box centred on the bounds, or hull)
+  Vec3f shapeCenter() const;      ///< where shape() is centred in the grid frame
+};
+
+/// Tag on LocalContact::feature for contacts against LOD boxes (never a brick id).
+constexpr uint32_t kLodFeature = 0x80000000u;
+
+class BrickGrid {
+ public:
+  struct Config {
+    uint32_t maxBricks = 1u << 22;       ///< reservation size (virtual)
+    std::array<float, 256> density;      ///< per material
+    Config() { density.fill(1.f); }
+    explicit Config(uint32_t max) : Config() { maxBricks = max; }
+  };
+
+  BrickGrid() : BrickGrid(Config{}) {}
+  explicit BrickGrid(const Config& config);
+
+  // ---- edits ----
+  /// Adds a brick (validated first; nothing changes on error). Returns its stable id.
+  uint32_t placeBrick(const Brick& b);
+  /// Removes a brick by id (InvalidInput for an unknown id).
+  void removeBrick(uint32_t id);
+  /// Counts edits; caches keyed on it are stale when it changes.
+  uint64_t editCount() const { return edits_; }
+
+  // ---- access ----
+  uint32_t brickCount() const { return bricks_.size(); }
+  bool hasBrick(uint32_t id) const { return bricks_.isLive(id); }
+  const Brick& brick(uint32_t id) const { return bricks_.get<0>(id); }
+  const OctoBvh& index() const { return index_; }
+  Aabb bounds() const { return index_.rootBounds(); }
+  template <class F>
+  void forEachBrick(F&& f) const { bricks_.forEachLive(std::forward<F>(f)); }
+  MassProperties massProperties() const;
+
+  // ---- queries (grid frame) ----
+  /// Closest hit on real brick shapes: exactly the smallest rayBrick() t over every brick within
+  /// [0, ray.maxT] (faces are closed, so grazing counts), ties going to the lowest OctoBVH handle.
+  /// InvalidInput for a non-finite origin or direction, a direction whose components are all
+  /// zero or denormal, or a NaN or negative maxT.
+  GridRayHit raycast(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr) const;
+  /// First time of impact of a shape (fixed rotation, grid frame) moving from `from` to `to`:
+  /// a ray traversal against bounds grown by the shape's extents, then conservative advancement
+  /// (GJK distances) against each candidate brick's real shape. The fraction is exactly the
+  /// smallest sweepShapeBrick() fraction over every brick; a zero motion tests the start pose.
+  GridSweepHit sweep(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to, uint32_t mask,
+                     QueryStats* stats = nullptr) const;
+  /// Bricks whose bounds overlap box (ids appended). InvalidInput for NaN bounds; infinite
+  /// bounds are fine.
+  void overlapBricks(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats = nullptr) const;
+
+  // ---- contacts ----
+  /// Contacts between a convex shape and this grid, both placed in the world. Contacts come back
+  /// in world space (normal from the grid towards the shape), reduced to params.maxContacts.
+  /// Returns the number appended to out.
+  size_t collide(const RigidTransform& gridPose, const QueryShape& shape, const RigidTransform& shapePose,
+                 const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out,
+                 ContactStats* stats = nullptr) const;
+  /// The same in the grid frame, without reduction (raw per-brick contacts appended).
+  void collideLocal(const QueryShape& shape, const LocalPose& pose, const ContactParams& params,
+                    std::vector<LocalContact>& out, ContactStats* stats = nullptr) const;
+
+  // ---- convex approximation ----
+  /// Hull of the bricks met in the first `depth` levels of the OctoBVH plus the bounds of the
+  /// subtrees left at that depth; a box when the hull is exactly its bounds. Cached per depth,
+  /// rebuilt lazily after edits. Not thread-safe (refreshes the cache).
+  const ConvexApproximation& convexApproximation(int depth);
+  /// Builds one without touching the cache.
+  ConvexApproximation buildConvexApproximation(int depth) const;
+
+ private:
+  Config config_;
+  ParallelVirtualPool<Brick, uint32_t> bricks_;  // brick, OctoBVH element handle
+  OctoBvh index_;
+  ShapeMoments moments_;                         // about reference_
+  Vec3d reference_ = Vec3d::Zero();
+  bool referenceSet_ = false;
+  uint64_t edits_ = 0;
+  struct CachedApproximation {
+    uint64_t edit = ~0ull;
+    ConvexApproximation value;
+  };
+  std::array<CachedApproximation, 8> approximations_;
+
+  float roundingMargin(const Vec3f& queryPoint) const;
+};
+
+/// Grid vs grid (article 000): the grid with fewer bricks collides as its convex approximation
+/// (box or hull, at `depth`) against the other's bricks. Contacts are world-space with normals
+/// pointing from `larger` towards `smaller`; returns which grid was treated as the smaller (0 =
+/// a, 1 = b) through smallerIndex.
+size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
+                    const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
+                    ContactStats* stats = nullptr);
+
+}  // namespace bw

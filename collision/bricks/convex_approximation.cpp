@@ -1,0 +1,119 @@
+// Convex approximation of a brick grid from its OctoBVH (article 000, "Convex Approximation
+// From OctoBVH" and "Convex Simplification to Box").
+#include <LinearMath/btConvexHullComputer.h>
+#include <algorithm>
+
+#include "collision/bricks/brick_grid.h"
+#include "collision/core/argument_checks.h"
+
+namespace bw {
+
+using namespace octobvh;
+
+namespace {
+
+// Points for the hull: exact vertices of bricks met above `depth` (large bricks held by inner
+// nodes, and whole small leaves), and the 8 corners of every subtree left at `depth`.
+void collectPoints(const BrickGrid& grid, uint32_t c, int s, int level, int depth, std::vector<Vec3f>& pts) {
+  const OctoBvh& tree = grid.index();
+  const NodeCluster& cl = tree.cluster(c);
+  if (cl.isEmpty(s)) return;
+  if (level == depth && cl.child[s] != kInvalidIndex) {
+    const Aabb b = cl.bounds(s);
+    for (int i = 0; i < 8; ++i)
+      pts.emplace_back((i & 1) ? b.max.x() : b.min.x(), (i & 2) ? b.max.y() : b.min.y(), (i & 4) ? b.max.z() : b.min.z());
+    return;
+  }
+  Vec3f v[kMaxBrickVertices];
+  tree.forEachHeldPublic(cl, s, [&](uint32_t e) {
+    const int n = brickVertices(grid.brick(tree.payload(e)), v);
+    pts.insert(pts.end(), v, v + n);
+  });
+  if (cl.child[s] != kInvalidIndex)
+    for (int o = 0; o < 8; ++o) collectPoints(grid, cl.child[s], o, level + 1, depth, pts);
+}
+
+}  // namespace
+
+QueryShape ConvexApproximation::shape() const {
+  if (isBox) return QueryShape::box(bounds.halfExtent().cwiseMax(Vec3f::Constant(1e-4f)));
+  return QueryShape::hull(centered.data(), uint32_t(centered.size()), float(hullVolume));
+}
+
+Vec3f ConvexApproximation::shapeCenter() const { return bounds.center(); }
+
+ConvexApproximation BrickGrid::buildConvexApproximation(int depth) const {
+  if (depth < 0 || depth > 16)
+    throw InvalidInput("BrickGrid::convexApproximation: depth is " + std::to_string(depth) + ", expected 0..16");
+  ConvexApproximation a;
+  a.depth = depth;
+  if (brickCount() == 0) return a;
+  std::vector<Vec3f> pts;
+  collectPoints(*this, index_.rootCluster(), 0, 0, depth, pts);
+  a.inputPoints = uint32_t(pts.size());
+  btConvexHullComputer hull;
+  hull.compute(pts[0].data(), int(sizeof(Vec3f)), int(pts.size()), 0, 0);
+  for (int i = 0; i < hull.vertices.size(); ++i) {
+    const btVector3& p = hull.vertices[i];
+    a.vertices.emplace_back(float(p.x()), float(p.y()), float(p.z()));
+    a.bounds.merge(a.vertices.back());
+  }
+  // Volume: fan-triangulate each face from its first vertex; tetrahedra against the centroid.
+  Vec3d centroid = Vec3d::Zero();
+  for (const Vec3f& p : a.vertices) centroid += p.cast<double>();
+  centroid /= double(std::max<size_t>(a.vertices.size(), 1));
+  for (int f = 0; f < hull.faces.size(); ++f) {
+    const btConvexHullComputer::Edge* first = &hull.edges[hull.faces[f]];
+    const Vec3d p0 = a.vertices[first->getSourceVertex()].cast<double>();
+    const btConvexHullComputer::Edge* e = first->getNextEdgeOfFace();
+    while (e->getTargetVertex() != first->getSourceVertex()) {
+      const Vec3d p1 = a.vertices[e->getSourceVertex()].cast<double>();
+      const Vec3d p2 = a.vertices[e->getTargetVertex()].cast<double>();
+      a.hullVolume += std::abs((p1 - p0).cross(p2 - p0).dot(centroid - p0)) / 6.0;
+      e = e->getNextEdgeOfFace();
+    }
+  }
+  // A box only when the hull has exactly 8 vertices and they are the 8 corners of its bounds
+  // (a wedge also has few vertices, but never all 8 corners).
+  if (a.vertices.size() == 8) {
+    const float eps = 1e-5f * std::max(1.f, a.bounds.extent().maxCoeff());
+    bool all = true;
+    for (int i = 0; i < 8 && all; ++i) {
+      const Vec3f corner((i & 1) ? a.bounds.max.x() : a.bounds.min.x(), (i & 2) ? a.bounds.max.y() : a.bounds.min.y(),
+                         (i & 4) ? a.bounds.max.z() : a.bounds.min.z());
+      all = std::any_of(a.vertices.begin(), a.vertices.end(), [&](const Vec3f& v) { return (v - corner).cwiseAbs().maxCoeff() <= eps; });
+    }
+    a.isBox = all;
+  }
+  const Vec3f c = a.bounds.center();
+  for (const Vec3f& v : a.vertices) a.centered.push_back(v - c);
+  return a;
+}
+
+const ConvexApproximation& BrickGrid::convexApproximation(int depth) {
+  if (depth < 0 || depth >= int(approximations_.size()))
+    throw InvalidInput("BrickGrid::convexApproximation: depth is " + std::to_string(depth) + ", cached depths are 0..7");
+  CachedApproximation& c = approximations_[depth];
+  if (c.edit != edits_) {
+    c.value = buildConvexApproximation(depth);
+    c.edit = edits_;
+  }
+  return c.value;
+}
+
+size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
+                    const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
+                    ContactStats* stats) {
+  const bool aSmaller = a.brickCount() <= b.brickCount();
+  smallerIndex = aSmaller ? 0 : 1;
+  BrickGrid& small = aSmaller ? a : b;
+  const BrickGrid& large = aSmaller ? b : a;
+  const RigidTransform& smallPose = aSmaller ? poseA : poseB;
+  const RigidTransform& largePose = aSmaller ? poseB : poseA;
+  if (small.brickCount() == 0 || large.brickCount() == 0) return 0;
+  const ConvexApproximation& approx = small.convexApproximation(depth);
+  const RigidTransform shapePose{smallPose.pointToWorld(approx.shapeCenter()), smallPose.rotation};
+  return large.collide(largePose, approx.shape(), shapePose, params, scratch, out, stats);
+}
+
+}  // namespace bw

@@ -1,0 +1,27 @@
+#pragma once
+/// Oriented box in a grid-local (float) frame: centre, half extents, and an orthonormal
+/// rotation whose columns are the box axes.
+#include "collision/core/aabb.h"
+
+namespace bw {
+
+struct Obb {
+  Vec3f center;
+  Vec3f half;   ///< half extents along the box axes (>= 0)
+  Mat3f axes;   ///< columns are the box's local x, y, z axes
+
+  static Obb fromAabb(const Aabb& b) { return {b.center(), b.halfExtent(), Mat3f::Identity()}; }
+
+  /// Tight axis-aligned bounds.
+  Aabb bounds() const {
+    const Vec3f r = axes.cwiseAbs() * half;
+    return {center - r, center + r};
+  }
+};
+
+/// Separating-axis test between an OBB and an AABB (15 axes). Closed boxes: touching overlaps.
+/// note: edge-edge axes get a small epsilon so near-parallel edges (cross product ~0) can
+/// never separate boxes that the face axes say overlap.
+bool overlaps(const Obb& a, const Aabb& b);
+
+}  // namespace bw

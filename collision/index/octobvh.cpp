@@ -1,0 +1,706 @@
+#include "collision/index/octobvh.h"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "collision/core/argument_checks.h"
+
+namespace bw {
+
+using namespace octobvh;
+
+namespace {
+
+// Worst-case pool use of one insert: root growth (<= 9 clusters per level over ~40 levels) plus
+// a split or forced split that may build chains down to kMinLevel for 9 elements.
+constexpr uint32_t kClusterHeadroom = 1024;
+constexpr uint32_t kLeafHeadroom = 1024;
+constexpr int8_t kEmptyMinLevel = -128;
+
+// Up to 9 elements moved between a node and its subtree (split, collapse, forced split).
+struct SmallList {
+  uint32_t v[16];
+  uint32_t n = 0;
+  void push(uint32_t x) { v[n++] = x; }
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------- cubes
+
+int OctoBvh::Cube::childSlotFor(const double c[3]) const {
+  const double half = pow2(level - 1);
+  return (c[0] >= origin[0] + half ? 1 : 0) | (c[1] >= origin[1] + half ? 2 : 0) | (c[2] >= origin[2] + half ? 4 : 0);
+}
+
+OctoBvh::Cube OctoBvh::Cube::child(int slot) const {
+  const double half = pow2(level - 1);
+  return {{origin[0] + ((slot & 1) ? half : 0.0), origin[1] + ((slot & 2) ? half : 0.0),
+           origin[2] + ((slot & 4) ? half : 0.0)},
+          level - 1};
+}
+
+OctoBvh::Cube OctoBvh::rootCube() const {
+  const double o = -std::ldexp(1.0, rootLevel_ - 1);
+  return {{o, o, o}, rootLevel_};
+}
+
+// ---------------------------------------------------------------- construction
+
+OctoBvh::OctoBvh(Config config)
+    : config_(config),
+      elements_(config.maxElements, "OctoBVH elements"),
+      clusters_(config.maxElements + kClusterHeadroom * 4, "OctoBVH node clusters"),
+      leaves_(config.maxElements + kLeafHeadroom * 4, "OctoBVH leaf blocks"),
+      overflow_(config.maxElements / 8 + 1024, "OctoBVH overflow blocks") {
+  if (config.maxElements == 0 || config.maxElements > (1u << 30))
+    throw InvalidInput("OctoBvh: maxElements is " + std::to_string(config.maxElements) + ", expected 1..2^30");
+  rootCluster_ = allocCluster(rootLevel_);
+}
+
+uint32_t OctoBvh::allocCluster(int level) {
+  const uint32_t c = clusters_.allocate();
+  NodeCluster& cl = clusters_[c];
+  const Aabb e = Aabb::empty();
+  for (int s = 0; s < 8; ++s) {
+    cl.setBounds(s, e);
+    cl.child[s] = kInvalidIndex;
+    cl.leaf[s] = kInvalidIndex;
+    cl.filter[s] = 0;
+    cl.numHeld[s] = 0;
+    cl.maxMinLevel[s] = kEmptyMinLevel;
+  }
+  cl.childTotal = 0;
+  cl.forcedCount = 0;
+  cl.level = int8_t(level);
+  return c;
+}
+
+void OctoBvh::clear() {
+  NodeCluster& root = clusters_[rootCluster_];
+  if (root.child[0] != kInvalidIndex) freeSubtreeClusters(root.child[0]);
+  std::vector<uint32_t> held;
+  heldTake(rootCluster_, 0, held);
+  clearNode(rootCluster_, 0);
+  std::vector<uint32_t> all;
+  elements_.forEachLive([&](uint32_t e) { all.push_back(e); });
+  for (uint32_t e : all) elements_.free(e);
+  rootLevel_ = kMinLevel + 1;
+  clusters_[rootCluster_].level = int8_t(rootLevel_);
+}
+
+// ---------------------------------------------------------------- validation of input
+
+void OctoBvh::validateElement(const Aabb& b, const char* context) const {
+  requireFinite(b.min, context, "bounds.min");
+  requireFinite(b.max, context, "bounds.max");
+  for (int i = 0; i < 3; ++i) {
+    if (b.min[i] > b.max[i])
+      throw InvalidInput(std::string(context) + ": bounds.min." + "xyz"[i] + " (" + std::to_string(b.min[i]) +
+                         ") is greater than bounds.max." + "xyz"[i] + " (" + std::to_string(b.max[i]) + ")");
+    if (std::abs(b.min[i]) >= kMaxCoordinate || std::abs(b.max[i]) >= kMaxCoordinate)
+      throw InvalidInput(std::string(context) + ": bounds on " + "xyz"[i] + " reach beyond the grid-local range +-2^30");
+  }
+}
+
+void OctoBvh::reserveHeadroom(const char* context) const {
+  if (elements_.size() >= elements_.capacity())
+    throw CapacityExceeded(std::string(context) + ": OctoBVH is full (" + std::to_string(elements_.capacity()) +
+                           " elements, see OctoBvh::Config::maxElements)");
+  if (clusters_.capacity() - clusters_.size() < kClusterHeadroom ||
+      leaves_.capacity() - leaves_.size() < kLeafHeadroom || overflow_.capacity() - overflow_.size() < 16)
+    throw CapacityExceeded(std::string(context) + ": OctoBVH node pools are exhausted (" +
+                           std::to_string(clusters_.size()) + " clusters in use)");
+}
+
+// ---------------------------------------------------------------- held elements
+
+uint32_t OctoBvh::heldCount(uint32_t c, int s) const {
+  const NodeCluster& cl = clusters_[c];
+  return cl.numHeld[s] == kOverflow ? overflow_[cl.leaf[s]].count : cl.numHeld[s];
+}
+
+void OctoBvh::heldAdd(uint32_t c, int s, uint32_t e) {
+  NodeCluster& cl = clusters_[c];
+  if (cl.numHeld[s] == 0) {
+    // note: a single held element is stored in the leaf field itself, no block.
+    cl.leaf[s] = e;
+    cl.numHeld[s] = 1;
+    return;
+  }
+  if (cl.numHeld[s] == 1) {
+    const uint32_t only = cl.leaf[s];
+    cl.leaf[s] = leaves_.allocate();
+    leaves_[cl.leaf[s]].elements[0] = only;
+  } else if (cl.numHeld[s] == kLeafCapacity) {
+    // Only a min-level leaf holds more than 8: convert to an overflow chain.
+    const uint32_t ob = overflow_.allocate();
+    OverflowBlock& o = overflow_[ob];
+    std::memcpy(o.elements, leaves_[cl.leaf[s]].elements, sizeof(LeafBlock));
+    o.count = kLeafCapacity;
+    o.next = kInvalidIndex;
+    leaves_.free(cl.leaf[s]);
+    cl.leaf[s] = ob;
+    cl.numHeld[s] = kOverflow;
+  }
+  if (cl.numHeld[s] == kOverflow) {
+    OverflowBlock& first = overflow_[cl.leaf[s]];
+    uint32_t idx = first.count++;
+    uint32_t b = cl.leaf[s];
+    while (idx >= 14) {
+      if (overflow_[b].next == kInvalidIndex) {
+        const uint32_t nb = overflow_.allocate();
+        overflow_[nb].next = kInvalidIndex;
+        overflow_[nb].count = 0;
+        overflow_[b].next = nb;
+      }
+      b = overflow_[b].next;
+      idx -= 14;
+    }
+    overflow_[b].elements[idx] = e;
+    return;
+  }
+  leaves_[cl.leaf[s]].elements[cl.numHeld[s]++] = e;
+}
+
+void OctoBvh::heldRemove(uint32_t c, int s, uint32_t e) {
+  NodeCluster& cl = clusters_[c];
+  if (cl.numHeld[s] == kOverflow) {
+    // Swap with the chain's last element, then shrink the chain.
+    OverflowBlock& first = overflow_[cl.leaf[s]];
+    const uint32_t last = first.count - 1;
+    uint32_t* lastSlot = nullptr;
+    uint32_t* found = nullptr;
+    uint32_t i = 0, lastBlockPrev = kInvalidIndex, lastBlock = cl.leaf[s];
+    for (uint32_t b = cl.leaf[s], prev = kInvalidIndex; b != kInvalidIndex; prev = b, b = overflow_[b].next) {
+      for (uint32_t k = 0; k < 14 && i <= last; ++k, ++i) {
+        if (overflow_[b].elements[k] == e) found = &overflow_[b].elements[k];
+        if (i == last) {
+          lastSlot = &overflow_[b].elements[k];
+          lastBlock = b;
+          lastBlockPrev = prev;
+        }
+      }
+    }
+    if (!found) throw std::logic_error("OctoBvh: element missing from its overflow leaf");
+    *found = *lastSlot;
+    first.count = last;
+    if (last % 14 == 0 && lastBlockPrev != kInvalidIndex) {  // the last block became empty
+      overflow_[lastBlockPrev].next = kInvalidIndex;
+      overflow_.free(lastBlock);
+    }
+    if (first.count == kLeafCapacity) {  // back to a plain leaf block
+      const uint32_t lb = leaves_.allocate();
+      std::memcpy(leaves_[lb].elements, first.elements, sizeof(LeafBlock));
+      overflow_.free(cl.leaf[s]);
+      cl.leaf[s] = lb;
+      cl.numHeld[s] = kLeafCapacity;
+    }
+    return;
+  }
+  if (cl.numHeld[s] == 1) {
+    if (cl.leaf[s] != e) throw std::logic_error("OctoBvh: element missing from the node that must hold it");
+    cl.leaf[s] = kInvalidIndex;
+    cl.numHeld[s] = 0;
+    return;
+  }
+  LeafBlock& lb = leaves_[cl.leaf[s]];
+  for (int i = 0; i < cl.numHeld[s]; ++i) {
+    if (lb.elements[i] == e) {
+      lb.elements[i] = lb.elements[--cl.numHeld[s]];
+      if (cl.numHeld[s] == 1) {  // back to an inline single element
+        const uint32_t only = lb.elements[0];
+        leaves_.free(cl.leaf[s]);
+        cl.leaf[s] = only;
+      }
+      return;
+    }
+  }
+  throw std::logic_error("OctoBvh: element missing from the node that must hold it");
+}
+
+void OctoBvh::heldTake(uint32_t c, int s, std::vector<uint32_t>& out) {
+  NodeCluster& cl = clusters_[c];
+  forEachHeld(cl, s, [&](uint32_t e) { out.push_back(e); });
+  if (cl.numHeld[s] == kOverflow) {
+    for (uint32_t b = cl.leaf[s]; b != kInvalidIndex;) {
+      const uint32_t next = overflow_[b].next;
+      overflow_.free(b);
+      b = next;
+    }
+  } else if (cl.numHeld[s] > 1) {
+    leaves_.free(cl.leaf[s]);
+  }
+  cl.numHeld[s] = 0;
+  cl.leaf[s] = kInvalidIndex;
+}
+
+// ---------------------------------------------------------------- node helpers
+
+void OctoBvh::clearNode(uint32_t c, int s) {
+  NodeCluster& cl = clusters_[c];
+  cl.setBounds(s, Aabb::empty());
+  cl.child[s] = kInvalidIndex;
+  cl.leaf[s] = kInvalidIndex;
+  cl.filter[s] = 0;
+  cl.numHeld[s] = 0;
+  cl.maxMinLevel[s] = kEmptyMinLevel;
+}
+
+bool OctoBvh::refit(uint32_t c, int s) {
+  NodeCluster& cl = clusters_[c];
+  Aabb b = Aabb::empty();
+  uint32_t filter = 0;
+  int mml = kEmptyMinLevel;
+  forEachHeld(cl, s, [&](uint32_t e) {
+    const ElementRecord& r = elements_[e];
+    b.merge(r.bounds());
+    filter |= r.filter;
+    mml = std::max(mml, minLevelOf(r));
+  });
+  if (cl.child[s] != kInvalidIndex) {
+    const NodeCluster& ch = clusters_[cl.child[s]];
+    for (int o = 0; o < 8; ++o) {
+      if (ch.isEmpty(o)) continue;
+      b.merge(ch.bounds(o));
+      filter |= ch.filter[o];
+      mml = std::max<int>(mml, ch.maxMinLevel[o]);
+    }
+  }
+  const bool changed = !(cl.bounds(s) == b) || cl.filter[s] != filter || cl.maxMinLevel[s] != mml;
+  cl.setBounds(s, b);
+  cl.filter[s] = filter;
+  cl.maxMinLevel[s] = int8_t(mml);
+  return changed;
+}
+
+void OctoBvh::makeLeaf(uint32_t c, int s, const uint32_t* elems, uint32_t count) {
+  for (uint32_t i = 0; i < count; ++i) heldAdd(c, s, elems[i]);
+  refit(c, s);
+}
+
+void OctoBvh::gatherSubtree(uint32_t cluster, int s, std::vector<uint32_t>& out) const {
+  const NodeCluster& cl = clusters_[cluster];
+  forEachHeld(cl, s, [&](uint32_t e) { out.push_back(e); });
+  if (cl.child[s] != kInvalidIndex)
+    for (int o = 0; o < 8; ++o)
+      if (!clusters_[cl.child[s]].isEmpty(o)) gatherSubtree(cl.child[s], o, out);
+}
+
+void OctoBvh::freeSubtreeClusters(uint32_t cluster) {
+  std::vector<uint32_t> dropped;
+  for (int o = 0; o < 8; ++o) {
+    if (clusters_[cluster].child[o] != kInvalidIndex) freeSubtreeClusters(clusters_[cluster].child[o]);
+    dropped.clear();
+    heldTake(cluster, o, dropped);
+  }
+  clusters_.free(cluster);
+}
+
+void OctoBvh::collectBig(uint32_t cluster, int s, int level, std::vector<uint32_t>& out) const {
+  const NodeCluster& cl = clusters_[cluster];
+  if (cl.maxMinLevel[s] < level) return;  // nothing that large below: skip the subtree
+  forEachHeld(cl, s, [&](uint32_t e) {
+    if (minLevelOf(elements_[e]) >= level) out.push_back(e);
+  });
+  if (cl.child[s] != kInvalidIndex)
+    for (int o = 0; o < 8; ++o) collectBig(cl.child[s], o, level, out);
+}
+
+// ---------------------------------------------------------------- canonical build
+
+void OctoBvh::build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32_t count) {
+  if (count <= uint32_t(kLeafCapacity) || cube.level == kMinLevel) {
+    makeLeaf(c, s, elems, count);
+    return;
+  }
+  // Elements that cannot go below this level first.
+  uint32_t* mid = std::partition(elems, elems + count, [&](uint32_t e) { return minLevelOf(elements_[e]) >= cube.level; });
+  const uint32_t big = uint32_t(mid - elems);
+  const bool forced = big > uint32_t(kLeafCapacity);
+  const uint32_t held = forced ? 0 : big;
+
+  const uint32_t child = allocCluster(cube.level - 1);
+  clusters_[c].child[s] = child;
+  clusters_[child].childTotal = count - held;
+  clusters_[child].forcedCount = forced ? big : 0;
+  for (uint32_t i = 0; i < held; ++i) heldAdd(c, s, elems[i]);
+
+  // 8-way partition of the rest by the child cube holding each centre.
+  uint32_t* down = elems + held;
+  const uint32_t n = count - held;
+  uint32_t counts[8] = {};
+  auto slotOf = [&](uint32_t e) {
+    double ctr[3];
+    centreOf(elements_[e], ctr);
+    return cube.childSlotFor(ctr);
+  };
+  for (uint32_t i = 0; i < n; ++i) ++counts[slotOf(down[i])];
+  uint32_t start[8], next[8];
+  for (int o = 0, acc = 0; o < 8; ++o) {
+    start[o] = next[o] = uint32_t(acc);
+    acc += int(counts[o]);
+  }
+  for (int o = 0; o < 8; ++o) {
+    const uint32_t end = start[o] + counts[o];
+    while (next[o] < end) {
+      const int t = slotOf(down[next[o]]);
+      if (t == o) ++next[o];
+      else std::swap(down[next[o]], down[next[t]++]);
+    }
+  }
+  for (int o = 0; o < 8; ++o)
+    if (counts[o]) build(child, o, cube.child(o), down + start[o], counts[o]);
+  refit(c, s);
+}
+
+int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {
+  int R = kMinLevel;
+  for (uint32_t e : elems) {
+    const ElementRecord& r = elements_[e];
+    R = std::max(R, minLevelOf(r));
+    double ctr[3];
+    centreOf(r, ctr);
+    for (double v : ctr)
+      while (!(v >= -std::ldexp(1.0, R) && v < std::ldexp(1.0, R))) ++R;
+  }
+  return R + 1;
+}
+
+std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+                                        const std::vector<uint32_t>& payloads) {
+  if (!empty()) throw InvalidInput("OctoBvh::bulkLoad: the tree must be empty");
+  if (filters.size() != bounds.size() || payloads.size() != bounds.size())
+    throw InvalidInput("OctoBvh::bulkLoad: bounds, filters and payloads differ in length (" +
+                       std::to_string(bounds.size()) + ", " + std::to_string(filters.size()) + ", " +
+                       std::to_string(payloads.size()) + ")");
+  for (const Aabb& b : bounds) validateElement(b, "OctoBvh::bulkLoad");
+  if (bounds.size() > elements_.capacity())
+    throw CapacityExceeded("OctoBvh::bulkLoad: " + std::to_string(bounds.size()) + " elements exceed the capacity of " +
+                           std::to_string(elements_.capacity()));
+  std::vector<uint32_t> handles(bounds.size());
+  for (size_t i = 0; i < bounds.size(); ++i) {
+    handles[i] = elements_.allocate();
+    ElementRecord& r = elements_[handles[i]];
+    for (int k = 0; k < 3; ++k) {
+      r.min[k] = bounds[i].min[k];
+      r.max[k] = bounds[i].max[k];
+    }
+    r.filter = filters[i];
+    r.payload = payloads[i];
+  }
+  if (handles.empty()) return handles;
+  rootLevel_ = canonicalRootLevel(handles);
+  clusters_[rootCluster_].level = int8_t(rootLevel_);
+  std::vector<uint32_t> order = handles;
+  build(rootCluster_, 0, rootCube(), order.data(), uint32_t(order.size()));
+  return handles;
+}
+
+// ---------------------------------------------------------------- insert
+
+uint32_t OctoBvh::insert(const Aabb& bounds, uint32_t filter, uint32_t payload) {
+  validateElement(bounds, "OctoBvh::insert");
+  reserveHeadroom("OctoBvh::insert");
+  const uint32_t e = elements_.allocate();
+  ElementRecord& r = elements_[e];
+  for (int k = 0; k < 3; ++k) {
+    r.min[k] = bounds.min[k];
+    r.max[k] = bounds.max[k];
+  }
+  r.filter = filter;
+  r.payload = payload;
+  double ctr[3];
+  centreOf(r, ctr);
+  growRootToHold(ctr, minLevelOf(r));
+  insertAt(rootCluster_, 0, rootCube(), e);
+  return e;
+}
+
+void OctoBvh::growRootToHold(const double c[3], int minLevel) {
+  for (;;) {
+    const int R = rootLevel_ - 1;
+    const double half = pow2(R);
+    bool inside = minLevel <= R;
+    for (int i = 0; i < 3; ++i) inside = inside && c[i] >= -half && c[i] < half;
+    if (inside) return;
+
+    NodeCluster& root = clusters_[rootCluster_];
+    if (root.child[0] != kInvalidIndex) {
+      // Each old root child (level R) moves into the new root child of its octant (level R+1),
+      // at the corner nearest the origin (slot o ^ 7). A leaf child just moves up a level.
+      const uint32_t oldC = root.child[0];
+      const uint32_t newC = allocCluster(R + 1);
+      for (int o = 0; o < 8; ++o) {
+        const NodeCluster& old = clusters_[oldC];
+        if (old.isEmpty(o)) continue;
+        NodeCluster& nc = clusters_[newC];
+        if (old.child[o] == kInvalidIndex && old.numHeld[o] == kOverflow) {
+          // A min-level leaf with > 8 elements cannot stay a leaf one level up: rebuild it.
+          std::vector<uint32_t> many;
+          heldTake(oldC, o, many);
+          const double no = -std::ldexp(1.0, R + 1);
+          const Cube newRootCube{{no, no, no}, R + 2};
+          build(newC, o, newRootCube.child(o), many.data(), uint32_t(many.size()));
+        } else if (old.child[o] == kInvalidIndex) {
+          nc.setBounds(o, old.bounds(o));
+          nc.leaf[o] = old.leaf[o];
+          nc.numHeld[o] = old.numHeld[o];
+          nc.filter[o] = old.filter[o];
+          nc.maxMinLevel[o] = old.maxMinLevel[o];
+        } else {
+          const uint32_t d = allocCluster(R);
+          NodeCluster& dc = clusters_[d];
+          const int t = o ^ 7;
+          dc.setBounds(t, old.bounds(o));
+          dc.child[t] = old.child[o];
+          dc.leaf[t] = old.leaf[o];
+          dc.numHeld[t] = old.numHeld[o];
+          dc.filter[t] = old.filter[o];
+          dc.maxMinLevel[t] = old.maxMinLevel[o];
+          dc.childTotal = heldCount(oldC, o) + clusters_[old.child[o]].childTotal;
+          nc.setBounds(o, old.bounds(o));
+          nc.child[o] = d;
+          nc.filter[o] = old.filter[o];
+          nc.maxMinLevel[o] = old.maxMinLevel[o];
+        }
+      }
+      clusters_[newC].childTotal = clusters_[oldC].childTotal;
+      clusters_.free(oldC);
+      clusters_[rootCluster_].child[0] = newC;
+    }
+    ++rootLevel_;
+    clusters_[rootCluster_].level = int8_t(rootLevel_);
+  }
+}
+
+void OctoBvh::passToChild(uint32_t c, int s, const Cube& cube, uint32_t e) {
+  const uint32_t child = clusters_[c].child[s];
+  ++clusters_[child].childTotal;
+  double ctr[3];
+  centreOf(elements_[e], ctr);
+  const int o = cube.childSlotFor(ctr);
+  insertAt(child, o, cube.child(o), e);
+}
+
+void OctoBvh::insertAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
+  const ElementRecord& r = elements_[e];
+  const int m = minLevelOf(r);
+  {
+    NodeCluster& cl = clusters_[c];
+    Aabb b = cl.bounds(s);
+    b.merge(r.bounds());
+    cl.setBounds(s, b);
+    cl.filter[s] |= r.filter;
+    cl.maxMinLevel[s] = int8_t(std::max<int>(cl.maxMinLevel[s], m));
+  }
+  NodeCluster& cl = clusters_[c];
+  if (cl.child[s] == kInvalidIndex) {
+    if (cl.numHeld[s] < kLeafCapacity || cube.level == kMinLevel) {
+      heldAdd(c, s, e);
+      return;
+    }
+    // A leaf reaching 9 elements splits into the canonical subtree of those 9.
+    std::vector<uint32_t> nine;
+    nine.reserve(9);
+    heldTake(c, s, nine);
+    nine.push_back(e);
+    build(c, s, cube, nine.data(), uint32_t(nine.size()));
+    return;
+  }
+  NodeCluster& ch = clusters_[cl.child[s]];
+  if (m >= cube.level) {
+    if (ch.forcedCount > 0) {
+      ++ch.forcedCount;
+      passToChild(c, s, cube, e);
+      return;
+    }
+    if (cl.numHeld[s] < kLeafCapacity) {
+      heldAdd(c, s, e);
+      return;
+    }
+    // A 9th element too large for the children: force-split all of them by centre.
+    std::vector<uint32_t> big;
+    big.reserve(9);
+    heldTake(c, s, big);
+    big.push_back(e);
+    ch.forcedCount = uint32_t(big.size());
+    for (uint32_t x : big) passToChild(c, s, cube, x);
+    return;
+  }
+  passToChild(c, s, cube, e);
+}
+
+// ---------------------------------------------------------------- remove
+
+void OctoBvh::remove(uint32_t handle) {
+  if (!elements_.isLive(handle))
+    throw InvalidInput("OctoBvh::remove: handle " + std::to_string(handle) + " is not an element of this tree");
+  removeAt(rootCluster_, 0, rootCube(), handle);
+  elements_.free(handle);
+  shrinkRoot();
+}
+
+void OctoBvh::update(uint32_t handle, const Aabb& bounds, uint32_t filter) {
+  if (!elements_.isLive(handle))
+    throw InvalidInput("OctoBvh::update: handle " + std::to_string(handle) + " is not an element of this tree");
+  validateElement(bounds, "OctoBvh::update");
+  reserveHeadroom("OctoBvh::update");
+  removeAt(rootCluster_, 0, rootCube(), handle);
+  shrinkRoot();
+  ElementRecord& r = elements_[handle];
+  for (int k = 0; k < 3; ++k) {
+    r.min[k] = bounds.min[k];
+    r.max[k] = bounds.max[k];
+  }
+  r.filter = filter;
+  double ctr[3];
+  centreOf(r, ctr);
+  growRootToHold(ctr, minLevelOf(r));
+  insertAt(rootCluster_, 0, rootCube(), handle);
+}
+
+bool OctoBvh::removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e) {
+  const uint32_t child = clusters_[c].child[s];
+  --clusters_[child].childTotal;
+  double ctr[3];
+  centreOf(elements_[e], ctr);
+  const int o = cube.childSlotFor(ctr);
+  return removeAt(child, o, cube.child(o), e);
+}
+
+// Returns whether the node's summary (bounds, filter OR, max min level) changed, so callers
+// above can skip their refit when it did not (most removals change only the bottom levels).
+bool OctoBvh::removeAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
+  NodeCluster& cl = clusters_[c];
+  if (cl.child[s] == kInvalidIndex) {
+    heldRemove(c, s, e);
+    return refit(c, s);
+  }
+  const uint32_t child = cl.child[s];
+  NodeCluster& ch = clusters_[child];
+  const uint32_t after = heldCount(c, s) + ch.childTotal - 1;
+  if (after <= uint32_t(kLeafCapacity)) {
+    // Merge back: the node becomes one leaf holding what is left of its subtree.
+    std::vector<uint32_t> rest;
+    rest.reserve(9);
+    heldTake(c, s, rest);
+    for (int o = 0; o < 8; ++o)
+      if (!ch.isEmpty(o)) gatherSubtree(child, o, rest);
+    rest.erase(std::find(rest.begin(), rest.end(), e));
+    freeSubtreeClusters(child);
+    clusters_[c].child[s] = kInvalidIndex;
+    for (uint32_t x : rest) heldAdd(c, s, x);
+    return refit(c, s);
+  }
+  const int m = minLevelOf(elements_[e]);
+  bool below = true;  // whether something below may have changed this node's summary
+  if (m >= cube.level) {
+    if (ch.forcedCount > uint32_t(kLeafCapacity) + 1) {
+      --ch.forcedCount;
+      below = removeFromChild(c, s, cube, e);
+    } else if (ch.forcedCount > 0) {
+      // Down to 8 large elements: undo the forced split. maxMinLevel leads straight to them.
+      ch.forcedCount = 0;
+      removeFromChild(c, s, cube, e);
+      std::vector<uint32_t> big;
+      big.reserve(8);
+      for (int o = 0; o < 8; ++o)
+        if (!clusters_[child].isEmpty(o)) collectBig(child, o, cube.level, big);
+      for (uint32_t x : big) removeFromChild(c, s, cube, x);
+      for (uint32_t x : big) heldAdd(c, s, x);
+    } else {
+      heldRemove(c, s, e);
+    }
+  } else {
+    below = removeFromChild(c, s, cube, e);
+  }
+  return below ? refit(c, s) : false;
+}
+
+void OctoBvh::shrinkRoot() {
+  for (;;) {
+    const int R = rootLevel_ - 1;
+    if (R <= kMinLevel) return;
+    NodeCluster& root = clusters_[rootCluster_];
+    if (root.isEmpty(0)) {
+      rootLevel_ = kMinLevel + 1;
+      root.level = int8_t(rootLevel_);
+      return;
+    }
+    if (root.maxMinLevel[0] > R - 1) return;
+    const double half = std::ldexp(1.0, R - 1);
+    bool fits = true;
+    auto heldInside = [&](const NodeCluster& cl, int s) {
+      forEachHeld(cl, s, [&](uint32_t e) {
+        double ctr[3];
+        centreOf(elements_[e], ctr);
+        for (double v : ctr) fits = fits && v >= -half && v < half;
+      });
+    };
+    if (root.child[0] == kInvalidIndex) {
+      heldInside(root, 0);
+      if (!fits) return;
+    } else {
+      const NodeCluster& C = clusters_[root.child[0]];
+      for (int o = 0; o < 8 && fits; ++o) {
+        if (C.isEmpty(o)) continue;
+        if (C.child[o] == kInvalidIndex) {
+          heldInside(C, o);
+        } else {
+          fits = C.numHeld[o] == 0;
+          const NodeCluster& D = clusters_[C.child[o]];
+          for (int t = 0; t < 8 && fits; ++t) fits = (t == (o ^ 7)) || D.isEmpty(t);
+        }
+      }
+      if (!fits) return;
+      // Reverse of growth: each root child's inner-corner content becomes the new root child.
+      const uint32_t oldC = root.child[0];
+      const uint32_t newC = allocCluster(R - 1);
+      for (int o = 0; o < 8; ++o) {
+        const NodeCluster& old = clusters_[oldC];
+        if (old.isEmpty(o)) continue;
+        NodeCluster& nc = clusters_[newC];
+        if (old.child[o] == kInvalidIndex) {
+          nc.setBounds(o, old.bounds(o));
+          nc.leaf[o] = old.leaf[o];
+          nc.numHeld[o] = old.numHeld[o];
+          nc.filter[o] = old.filter[o];
+          nc.maxMinLevel[o] = old.maxMinLevel[o];
+        } else {
+          const uint32_t d = old.child[o];
+          const NodeCluster& dc = clusters_[d];
+          const int t = o ^ 7;
+          nc.setBounds(o, dc.bounds(t));
+          nc.child[o] = dc.child[t];
+          nc.leaf[o] = dc.leaf[t];
+          nc.numHeld[o] = dc.numHeld[t];
+          nc.filter[o] = dc.filter[t];
+          nc.maxMinLevel[o] = dc.maxMinLevel[t];
+          clusters_.free(d);
+        }
+      }
+      clusters_[newC].childTotal = clusters_[oldC].childTotal;
+      clusters_.free(oldC);
+      clusters_[rootCluster_].child[0] = newC;
+    }
+    --rootLevel_;
+    clusters_[rootCluster_].level = int8_t(rootLevel_);
+  }
+}
+
+}  // namespace bw
+
+namespace bw {
+
+void OctoBvh::overlap(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats) const {
+  overlap(box, mask, [&](uint32_t e) { out.push_back(e); }, stats);
+}
+
+void OctoBvh::overlap(const Obb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats) const {
+  overlap(box, mask, [&](uint32_t e) { out.push_back(e); }, stats);
+}
+
+}  // namespace bw

@@ -1,0 +1,200 @@
+#pragma once
+/// OctoBVH (article 000): a loose octree whose nodes store tight bounds, with forced splits of
+/// overfilled nodes, filter bits and a canonical structure.
+///
+///   bw::OctoBvh tree;
+///   uint32_t h = tree.insert(brickBounds, /*filter*/ 1, /*payload*/ brickIndex);
+///   tree.overlap(queryBox, mask, [&](uint32_t element) { ... });
+///   bw::RayHit hit = tree.raycastClosest(bw::Ray::make(origin, dir, 200.f), mask);
+///   tree.remove(h);
+///
+/// Structure (a pure function of the element set, whatever the order of edits):
+/// - An element's min level is the smallest L with 2^L >= its largest extent; it is placed by
+///   its centre. The root is the cube [-2^R, 2^R)^3 with the smallest R holding every centre
+///   and every min level; below it every node is a lattice cube [k 2^L, (k+1) 2^L).
+/// - A node whose subtree holds <= 8 elements is a leaf holding them all. Otherwise elements
+///   that fit a child (min level < L) go to the child holding their centre and the rest stay;
+///   if more than 8 would stay, all of them are forced into the children by centre.
+/// - Recursion stops at level kMinLevel, where a leaf may hold more than 8.
+/// Inserts and removes re-evaluate these rules only along the path they touch; tight bounds,
+/// filter ORs and counts are kept up to date incrementally.
+///
+/// Thread safety: queries are const and may run concurrently; edits need exclusive access.
+/// Errors: bad input (NaN, inf, inverted bounds, |coordinate| > 2^30, unknown handle) throws
+/// InvalidInput and a full pool throws CapacityExceeded, both before anything is modified.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "collision/core/obb.h"
+#include "collision/core/ray.h"
+#include "collision/core/virtual_pool.h"
+#include "collision/index/octobvh_layout.h"
+#include "collision/index/spatial_query_types.h"
+
+namespace bw {
+
+class OctoBvh {
+ public:
+  struct Config {
+    uint32_t maxElements = 1u << 22;  ///< reservation size (virtual; costs nothing until used)
+  };
+  /// Memory use by kind (live pool slots, not virtual reservations).
+  struct MemoryStats {
+    uint64_t clusters = 0, nodes = 0, nonEmptyNodes = 0, leafBlocks = 0, overflowBlocks = 0, elements = 0;
+    uint64_t nodeBytes = 0, leafBytes = 0, elementBytes = 0;
+    uint64_t totalBytes() const { return nodeBytes + leafBytes + elementBytes; }
+  };
+  /// Shape figures of the tree.
+  struct ShapeStats {
+    int depth = 0;                   ///< levels from the root to the deepest node
+    uint64_t leaves = 0;             ///< non-empty nodes without children
+    uint64_t innerNodes = 0;         ///< nodes with children
+    uint64_t forcedNodes = 0;        ///< inner nodes that force-split
+    uint64_t forcedElements = 0;     ///< elements sitting below their min level
+  };
+
+  OctoBvh() : OctoBvh(Config{}) {}
+  explicit OctoBvh(Config config);
+
+  // ---- edits ----
+  /// Adds an element; returns its stable handle.
+  uint32_t insert(const Aabb& bounds, uint32_t filter, uint32_t payload);
+  /// Removes an element by handle.
+  void remove(uint32_t handle);
+  /// Moves/resizes an element and changes its filter bits; the handle stays.
+  void update(uint32_t handle, const Aabb& bounds, uint32_t filter);
+  /// Builds the tree of the given elements in one pass (same structure as inserting them one
+  /// by one). The tree must be empty. Returns the handles in input order.
+  std::vector<uint32_t> bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+                                 const std::vector<uint32_t>& payloads);
+  /// Removes every element.
+  void clear();
+
+  // ---- element access ----
+  uint32_t size() const { return elements_.size(); }
+  bool empty() const { return elements_.size() == 0; }
+  bool contains(uint32_t handle) const { return elements_.isLive(handle); }
+  Aabb bounds(uint32_t handle) const { return elements_[handle].bounds(); }
+  uint32_t filter(uint32_t handle) const { return elements_[handle].filter; }
+  uint32_t payload(uint32_t handle) const { return elements_[handle].payload; }
+  /// Tight bounds of everything (empty box when the tree is empty).
+  Aabb rootBounds() const { return clusters_[rootCluster_].bounds(0); }
+  /// Level of the root cube: it spans [-2^(level-1), 2^(level-1)).
+  int rootLevel() const { return rootLevel_; }
+  /// Calls f(handle) for every element in handle order.
+  template <class F>
+  void forEachElement(F&& f) const { elements_.forEachLive(std::forward<F>(f)); }
+
+  // ---- queries (all take a filter mask: an element matches when filter & mask != 0) ----
+  /// f(handle) for every element overlapping box whose exact(handle, elementBounds) is true.
+  template <class F, class Exact = AabbOverlapExact>
+  void overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* stats = nullptr, Exact&& exact = {}) const;
+  /// Collecting form: appends handles to out.
+  void overlap(const Aabb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats = nullptr) const;
+  /// Oriented-box overlap (separating-axis test against node and element bounds).
+  template <class F, class Exact = AabbOverlapExact>
+  void overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stats = nullptr, Exact&& exact = {}) const;
+  void overlap(const Obb& box, uint32_t mask, std::vector<uint32_t>& out, QueryStats* stats = nullptr) const;
+  /// Collision LOD: a subtree whose bounds' largest extent is below lodFraction times the query
+  /// box's largest extent is reported once through onLod as a solid box instead of descending.
+  template <class F, class L>
+  void overlapLod(const Aabb& box, uint32_t mask, float lodFraction, F&& onElement, L&& onLod,
+                  QueryStats* stats = nullptr) const;
+
+  /// Closest hit along the ray within [0, ray.maxT]; exact(handle, tEnterBox, tMax, tHit).
+  template <class Exact = AabbRayExact>
+  RayHit raycastClosest(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr, Exact&& exact = {},
+                        RayChildOrder order = RayChildOrder::FrontToBack) const;
+  /// Sweep of a shape whose bounds have the given half extents along the ray (t in ray units):
+  /// traversal against bounds grown by the extents; exact(handle, tEnterGrownBox, tMax, tHit)
+  /// gives the shape's real time of impact.
+  template <class Exact>
+  RayHit sweepClosest(const Ray& ray, const Vec3f& halfExtents, uint32_t mask, Exact&& exact,
+                      QueryStats* stats = nullptr) const;
+  /// Some hit (the first found), or none.
+  template <class Exact = AabbRayExact>
+  RayHit raycastAny(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr, Exact&& exact = {}) const;
+  /// Every hit within [0, ray.maxT], sorted by t then handle.
+  template <class Exact = AabbRayExact>
+  void raycastAll(const Ray& ray, uint32_t mask, std::vector<RayHit>& out, QueryStats* stats = nullptr,
+                  Exact&& exact = {}) const;
+
+  // ---- diagnostics ----
+  /// Hash of the structure (node levels, counts, bounds, held elements by bounds/filter/payload):
+  /// equal for equal element sets whatever the edit history; independent of handle values.
+  uint64_t structureHash() const;
+  /// Walks the whole tree and throws std::logic_error describing the first broken invariant
+  /// (counts, tight bounds, filter ORs, min levels, canonical placement). For tests.
+  void validate() const;
+  MemoryStats memoryStats() const;
+  ShapeStats shapeStats() const;
+  size_t residentBytes() const;
+
+  /// Child visiting order for a ray direction, computed once per ray (see octobvh_queries.h).
+  static std::array<uint8_t, 8> rayChildOrder(const Vec3f& dir);
+
+  // Read-only access to the layout, for tools that draw or inspect the tree.
+  const octobvh::NodeCluster& cluster(uint32_t c) const { return clusters_[c]; }
+  uint32_t rootCluster() const { return rootCluster_; }
+  const octobvh::ElementRecord& element(uint32_t h) const { return elements_[h]; }
+  /// f(handle) for each element held directly at node (cluster, slot).
+  template <class F>
+  void forEachHeldPublic(const octobvh::NodeCluster& cl, int s, F&& f) const { forEachHeld(cl, s, std::forward<F>(f)); }
+
+ private:
+  using NodeCluster = octobvh::NodeCluster;
+  struct Cube {  // lattice cube of a node: origin (exact in double) and level
+    double origin[3];
+    int level;
+    int childSlotFor(const double c[3]) const;
+    Cube child(int slot) const;
+  };
+
+  void validateElement(const Aabb& b, const char* context) const;
+  void reserveHeadroom(const char* context) const;
+  Cube rootCube() const;
+  void growRootToHold(const double centre[3], int minLevel);
+  void shrinkRoot();
+  int canonicalRootLevel(const std::vector<uint32_t>& elems) const;
+
+  void insertAt(uint32_t c, int s, const Cube& cube, uint32_t e);
+  bool removeAt(uint32_t c, int s, const Cube& cube, uint32_t e);
+  void passToChild(uint32_t c, int s, const Cube& cube, uint32_t e);
+  bool removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e);
+  void build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32_t count);
+  void makeLeaf(uint32_t c, int s, const uint32_t* elems, uint32_t count);
+  void collectBig(uint32_t c, int s, int level, std::vector<uint32_t>& out) const;
+  void gatherSubtree(uint32_t c, int s, std::vector<uint32_t>& out) const;
+  void freeSubtreeClusters(uint32_t cluster);
+  bool refit(uint32_t c, int s);
+  void clearNode(uint32_t c, int s);
+  uint32_t allocCluster(int level);
+
+  // held-element lists (leaf blocks, or overflow chains at kMinLevel)
+  uint32_t heldCount(uint32_t c, int s) const;
+  void heldAdd(uint32_t c, int s, uint32_t e);
+  void heldRemove(uint32_t c, int s, uint32_t e);
+  void heldTake(uint32_t c, int s, std::vector<uint32_t>& out);
+  template <class F>
+  void forEachHeld(const NodeCluster& cl, int s, F&& f) const;
+  template <class OnElement, class Accept>
+  void walkOverlap(const Aabb& outer, uint32_t mask, QueryStats* stats, OnElement&& onElement, Accept&& accept) const;
+
+  uint64_t hashNode(uint32_t c, int s) const;
+  void validateNode(uint32_t c, int s, const Cube& cube, std::vector<uint32_t>& seen) const;
+  void shapeNode(uint32_t c, int s, int depth, ShapeStats& st) const;
+
+  Config config_;
+  VirtualPool<octobvh::ElementRecord> elements_;
+  VirtualPool<NodeCluster> clusters_;
+  VirtualPool<octobvh::LeafBlock> leaves_;
+  VirtualPool<octobvh::OverflowBlock> overflow_;
+  uint32_t rootCluster_ = kInvalidIndex;  ///< slot 0 is the root node
+  int rootLevel_ = octobvh::kMinLevel + 1;
+  std::vector<uint32_t> scratch_;          ///< reused by edits that move element groups
+};
+
+}  // namespace bw
+
+#include "collision/index/octobvh_queries.h"

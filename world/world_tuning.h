@@ -1,0 +1,66 @@
+#pragma once
+/// Every tuning constant of the world's step, named, with why it has its value. Scene settings
+/// (SceneSettings) are what a scene may change; these are the fixed choices behind them.
+#include <cstdint>
+
+namespace bw::tuning {
+
+// --- Broadphase and speculative contacts --------------------------------------------------
+/// Body bounds grow by this (m) beyond how far the body can move in one frame, so resting
+/// bodies keep their pairs through small motions and pairs are not found one frame late.
+inline constexpr double kBroadphaseMargin = 0.02;
+/// Contacts are made for gaps up to this (m) plus the pair's closing speed x dt: a resting
+/// contact survives micro-separation, and a fast body meets a thin plate before passing it.
+inline constexpr float kSpeculativeMargin = 0.01f;
+
+// --- Solver -------------------------------------------------------------------------------
+/// Baumgarte factor: the share of the penetration (beyond kSlop) pushed out per step.
+inline constexpr float kBaumgarte = 0.2f;
+/// Penetration left alone (m): resting contacts keep a little overlap, so they do not flicker.
+inline constexpr float kSlop = 0.005f;
+/// Restitution of impacts faster than kBounceThreshold (m/s); slower ones do not bounce, so
+/// resting bodies do not jitter.
+inline constexpr float kRestitution = 0.1f;
+inline constexpr float kBounceThreshold = 1.0f;
+/// Deep overlaps (bodies spawned inside each other or inside terrain) separate at most this
+/// fast (m/s): Baumgarte alone would turn a 1 m overlap into a 12 m/s launch.
+inline constexpr float kMaxPushOut = 3.0f;
+/// Friction's first tangent is built from the normal's y/z (or x/y) components: this threshold
+/// on |normal.x| (about 1/sqrt(3)) picks a pair that is never near zero, so it normalises safely.
+inline constexpr float kTangentThreshold = 0.57f;
+/// Warm starting takes the cached impulse of the same pair and feature whose point lies
+/// nearest the new contact, within this radius (m): a contact that slid further starts cold.
+inline constexpr double kWarmStartRadius = 0.05;
+/// Shock propagation orders two dynamic bodies only when their heights (along gravity) differ
+/// by more than this (m); side-by-side bodies are solved as usual.
+inline constexpr double kShockHeightEpsilon = 1e-3;
+
+// --- Islands ------------------------------------------------------------------------------
+/// Islands with more contacts than this are coloured and solved colour by colour on every
+/// thread; smaller ones are solved whole, one island per job.
+inline constexpr uint32_t kSplitContacts = 512;
+/// Colours per split island (one bit each in a 64-bit mask); contacts left over form a last,
+/// serial group.
+inline constexpr uint32_t kMaxColours = 64;
+/// Contacts per job when a colour is solved in parallel.
+inline constexpr uint32_t kColourGrain = 64;
+/// Pairs per job in contact generation (a pair may be a grid query of many bricks).
+inline constexpr uint32_t kPairGrain = 4;
+/// Rays per job in the scene's ray load.
+inline constexpr uint32_t kRayGrain = 64;
+
+// --- Sleeping -----------------------------------------------------------------------------
+/// An island whose bodies all stayed below these speeds (m/s, rad/s) for kSleepTime (s) sleeps.
+inline constexpr float kSleepLinear = 0.05f, kSleepAngular = 0.1f, kSleepTime = 0.5f;
+
+// --- Water --------------------------------------------------------------------------------
+/// Velocities decay at this rate (1/s) times the submerged fraction, so floating bodies settle
+/// instead of bobbing for ever (a crate of half water's density rises at about
+/// g / kWaterLinearDrag = 2.5 m/s and does not leap out of the surface).
+inline constexpr float kWaterLinearDrag = 4.f, kWaterAngularDrag = 4.f;
+/// The centre of buoyancy is estimated from the body's bounding box, so only a body cut by the
+/// surface (submerged fraction below this) gets the righting torque; a submerged one would get
+/// a spurious torque wherever its box overlaps solid voxels (and spin up without bound).
+inline constexpr float kBuoyancyTorqueBelowFraction = 0.98f;
+
+}  // namespace bw::tuning
