@@ -27,7 +27,8 @@ struct AttachmentWorkloadDesc {
   Vec3d worldOffset = Vec3d::Zero();  ///< ...centred here (far offsets exercise double precision)
 };
 
-/// SoA body poses with seeded motion (stand-in for the world's bodies until the world exists).
+/// SoA body poses with seeded motion: the synthetic load of `batch-bench` and bench_batch, where
+/// every body moves every frame.
 class BodyMotion {
  public:
   /// count bodies placed from the seed.

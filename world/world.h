@@ -26,7 +26,12 @@
 #include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/broadphase.h"
+#include "world/contact_solver.h"
+#include "world/islands.h"
+#include "world/pair_cache.h"
+#include "world/ray_load.h"
 #include "world/scene_description.h"
+#include "world/sleeping.h"
 
 namespace bw {
 
@@ -85,82 +90,32 @@ class World {
   const std::vector<std::vector<Contact>>& probeContacts(float lodFraction, int approximationDepth, int manifoldSize,
                                                          uint64_t* boxTests = nullptr);
   /// Dynamic bodies currently asleep.
-  uint32_t sleepingCount() const;
+  uint32_t sleepingCount() const { return sleep_.count(); }
+  /// The scene's ray load of the last frame: its rays and their closest hits (empty without one).
+  const RayLoad& rayLoad() const { return rayLoad_; }
 
  private:
-  struct SolverContact {
-    uint32_t a, b;         // a receives +impulse along normal, b the opposite
-    Vec3d point;
-    Vec3f normal;          // from b towards a
-    float depth;
-    uint64_t key;          // pair and feature, for warm starting
-    Vec3f rA, rB, t1, t2;
-    // Angular response per unit impulse along n, t1, t2 (inverse inertia x (r x d)), computed
-    // once per substep so iterations are multiply-adds.
-    Vec3f angA[3], angB[3];
-    float massN, massT1, massT2, bias, relaxBias, friction;
-    // Shock propagation: effective masses with the lower body immovable, which body is lower
-    // along gravity (0 none, 1 a, 2 b) and the contact's height (for the bottom-up order).
-    float shockMass[3];
-    uint8_t shockLower = 0;
-    double height = 0;
-    float lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0;
-  };
-  // A pair's contacts kept in both bodies' frames, reused while their relative pose barely
-  // changes (the pair cache): resting piles do not redo narrowphase every step.
-  struct CachedContact {
-    Vec3f onA, onB;   // contact points in body a's and body b's frames (a, b as in the pair)
-    Vec3f normalB;    // normal in b's frame, oriented as the slot stores it
-    uint32_t feature, material;
-  };
-  struct PairCacheEntry {
-    BodyPair pair;
-    RigidTransform relative;   // b's pose in a's frame when the contacts were made
-    uint8_t flipped;
-    uint32_t first, count;     // range in pairCacheContacts_
-  };
-  struct CachedImpulse {
-    uint64_t key;
-    Vec3d point;
-    float n, t1, t2;
-  };
-
+  // Scene building (scene_build.cpp).
   std::vector<Brick> gridBricks(const GridDescription& g) const;
   void buildGrid(const GridDescription& g);
-  void fireRays();
   void buildTerrain(const TerrainDescription& t);
-  void terrainPairs(float dt);
   void spawn(const SpawnerDescription& s);
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
-  void substep(float dt, int index);
+  // Bounds and contacts (contact_generation.cpp, terrain_pairs.cpp).
   void computeBounds();
   void generateContacts(float dt);
-  void prepareSolver(float dt);
-  void solve(bool relax);
-  void solveIsland(uint32_t island, bool relax);
-  void solveIslandInColours(uint32_t island, bool relax);
-  void colourIsland(uint32_t island);
-  void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
-  void warmStart(const SolverContact& s);
-  void loadSolverBodies();
-  void storeSolverBodies();
-  void solveContact(SolverContact& s, bool relax);
-  void solveContactShock(SolverContact& s);
-  void shockSweep(std::vector<uint32_t>& contacts);
+  void terrainPairs(float dt);
+  bool canCollide(uint32_t a, uint32_t b) const;
+  bool active(uint32_t body) const {
+    return bodies_.motion[body] == MotionType::Kinematic || (bodies_.motion[body] == MotionType::Dynamic && !sleep_.asleep(body));
+  }
+  // The step (world.cpp).
+  void substep(float dt, int index);
+  void integrate(float dt);
+  void applyGridEdits();
   // Profiling stages per substep: broadphase, contacts, prepare, solve, integrate, relax.
   static constexpr int kStagesPerSubstep = 6;
-  // Islands with more contacts than this are solved colour by colour on every thread.
-  static constexpr uint32_t kSplitContacts = 512;
-  static constexpr uint32_t kMaxColours = 64;
-  static constexpr uint32_t kColourGrain = 64;
-  void buildIslands();
-  void updateSleep(float dt);
-  bool active(uint32_t body) const {
-    return bodies_.motion[body] == MotionType::Kinematic || (bodies_.motion[body] == MotionType::Dynamic && !asleep_[body]);
-  }
-  void integrate(float dt);
-  bool canCollide(uint32_t a, uint32_t b) const;
 
   SceneDescription scene_;
   JobSystem jobs_;
@@ -179,35 +134,15 @@ class World {
   std::vector<std::vector<Contact>> pairContacts_;  // one slot per pair, reused across frames
   std::vector<ContactScratch> scratch_;             // one per pair slot
   std::vector<uint8_t> pairFlipped_;                // slot's contacts have normal from pair.a to pair.b
+  std::vector<uint8_t> pairReused_;                 // slot's contacts came from the pair cache
   std::vector<ContactStats> pairStats_;
-  std::vector<SolverContact> contacts_;
-  struct SolverBody {
-    Vec3f v;            // 12 linear velocity
-    float invMass;      // 4
-    Vec3f w;            // 12 angular velocity (world)
-    uint32_t dynamic;   // 4  0: static or kinematic (read, never written)
-  };
-  static_assert(sizeof(SolverBody) == 32);
-  std::vector<SolverBody> solverBodies_;
-  std::vector<Mat3f> inverseInertiaWorld_;          // per body, this substep
-  std::vector<uint32_t> islandOf_;                  // union-find parent per body
-  std::vector<uint32_t> islandStart_, islandContacts_;  // contacts grouped by island (CSR)
-  std::vector<uint32_t> islandBodiesStart_, islandBodies_;
-  std::vector<uint32_t> smallIslands_;              // islands solved whole, in parallel
-  std::vector<uint64_t> bodyColours_;               // per body: colours taken (while colouring)
-  std::vector<uint32_t> colourOf_, colourStart_, colourContacts_, colourFill_;  // one split island
-  std::vector<float> stillTime_;                    // seconds each body has been nearly still
-  std::vector<uint8_t> asleep_;
-  std::vector<CachedImpulse> cache_, nextCache_;
-  std::vector<PairCacheEntry> pairCache_, nextPairCache_;
-  std::vector<CachedContact> pairCacheContacts_, nextPairCacheContacts_;
-  std::vector<int32_t> pairCacheHit_;  // per pair slot: index into pairCache_ or -1
-  void updatePairCache();
+  PairCache pairCache_;
+  ContactSolver solver_;
+  Islands islands_;
+  SleepState sleep_;
+  RayLoad rayLoad_;
   std::vector<uint32_t> editedGrids_;  // grids handed out by editGrid() since the last step
-  void applyGridEdits();
   StepStats stats_;
-  std::vector<float> rayHitT_;  // per ray of the ray load: closest hit (inf: none)
-  std::vector<QueryStats> rayStats_;
   uint32_t frame_ = 0;
   int stage_ = 0;  // first profiling stage id of the running substep
 };

@@ -19,13 +19,6 @@ constexpr uint32_t kClusterHeadroom = 1024;
 constexpr uint32_t kLeafHeadroom = 1024;
 constexpr int8_t kEmptyMinLevel = -128;
 
-// Up to 9 elements moved between a node and its subtree (split, collapse, forced split).
-struct SmallList {
-  uint32_t v[16];
-  uint32_t n = 0;
-  void push(uint32_t x) { v[n++] = x; }
-};
-
 }  // namespace
 
 // ---------------------------------------------------------------- cubes

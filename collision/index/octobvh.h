@@ -192,7 +192,6 @@ class OctoBvh {
   VirtualPool<octobvh::OverflowBlock> overflow_;
   uint32_t rootCluster_ = kInvalidIndex;  ///< slot 0 is the root node
   int rootLevel_ = octobvh::kMinLevel + 1;
-  std::vector<uint32_t> scratch_;          ///< reused by edits that move element groups
 };
 
 }  // namespace bw

@@ -1,0 +1,136 @@
+// Contacts per pair: the bodies' broadphase bounds, then every pair's contacts in parallel
+// (primitive vs grid through the grid's query, grid vs grid through the smaller grid's convex
+// approximation, primitive pairs directly), each pair writing its own slot, with speculative
+// margins and the pair cache. Pairs with a terrain are made afterwards (terrain_pairs.cpp).
+#include "world/scene_validation.h"
+#include "world/world.h"
+#include "world/world_tuning.h"
+
+namespace bw {
+
+bool World::canCollide(uint32_t a, uint32_t b) const {
+  return bodies_.inverseMass[a] > 0.f || bodies_.inverseMass[b] > 0.f;
+}
+
+void World::computeBounds() {
+  const uint32_t n = bodies_.size();
+  bounds_.resize(n);
+  isStatic_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const RigidTransform pose = bodies_.shapePose(i);
+    const Mat3f R = pose.rotation.toRotationMatrix().cwiseAbs();
+    Vec3d centre, half;
+    if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) {
+      Aabb b;
+      if (bodies_.shape[i].isGrid()) {
+        b = grids_[bodies_.shape[i].grid]->bounds();
+      } else {
+        const Terrain& t = *terrains_[bodies_.shape[i].terrain];
+        const Int3 size = t.voxels().size();
+        b = {Vec3f::Zero(), Vec3f(float(size.x), float(size.y), float(size.z)) * t.voxelSize()};
+      }
+      centre = pose.pointToWorld(b.center());
+      half = (R * b.halfExtent()).cast<double>();
+    } else {
+      centre = pose.translation;
+      half = (R * bodies_.shape[i].primitive.localHalfExtents()).cast<double>();
+    }
+    // A margin of how far the body can move this frame keeps fast bodies in their pairs.
+    const double margin = tuning::kBroadphaseMargin + double(bodies_.linearVelocity[i].norm()) * scene_.settings.timestep;
+    bounds_[i] = {centre - half - Vec3d::Constant(margin), centre + half + Vec3d::Constant(margin)};
+    isStatic_[i] = bodies_.motion[i] == MotionType::Static;
+  }
+}
+
+void World::generateContacts(float dt) {
+  const uint32_t n = uint32_t(pairs_.size());
+  if (pairContacts_.size() < n) {
+    pairContacts_.resize(n);
+    scratch_.resize(n);
+  }
+  pairFlipped_.assign(n, 0);
+  pairStats_.assign(n, ContactStats{});
+  ContactParams base;
+  base.lodFraction = scene_.settings.lodFraction;
+  base.maxContacts = scene_.settings.manifoldSize;
+  // Convex approximations are cached per grid and refreshed lazily: warm them serially so the
+  // parallel stage only reads them (copies of one crate grid share one cache).
+  for (const BodyPair& p : pairs_) {
+    const BodyShape& sa = bodies_.shape[p.a];
+    const BodyShape& sb = bodies_.shape[p.b];
+    if (sa.isGrid() && sb.isGrid() && canCollide(p.a, p.b) && (active(p.a) || active(p.b))) {
+      BrickGrid& ga = *grids_[sa.grid];
+      BrickGrid& gb = *grids_[sb.grid];
+      (ga.brickCount() <= gb.brickCount() ? ga : gb).convexApproximation(scene_.settings.approximationDepth);
+    }
+  }
+  // Pair cache: a pair whose relative pose has barely moved reuses its last contacts.
+  pairCache_.match(pairs_);
+  pairReused_.assign(n, 0);
+  // Each pair writes only its own slot: the result does not depend on the thread count.
+  jobs_.parallelFor(0, n, tuning::kPairGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler_, "contacts", stage_ + 1);
+    for (uint32_t k = begin; k < end; ++k) {
+      std::vector<Contact>& out = pairContacts_[k];
+      out.clear();
+      uint32_t a = pairs_[k].a, b = pairs_[k].b;
+      if (!canCollide(a, b) || (!active(a) && !active(b))) continue;  // nothing awake: nothing to do
+      if (bodies_.shape[a].isTerrain() || bodies_.shape[b].isTerrain()) continue;  // terrainPairs()
+      const RigidTransform poseA{bodies_.position[a], bodies_.rotation[a]}, poseB{bodies_.position[b], bodies_.rotation[b]};
+      if (pairCache_.reuse(k, poseA, poseB, scene_.settings.reuseTranslation, scene_.settings.reuseRotation, out, pairFlipped_[k])) {
+        pairReused_[k] = 1;
+        continue;
+      }
+      // Speculative contacts: look as far ahead as the pair can close in one step, so fast
+      // bodies meet thin plates before they pass them (the solver lets gaps close, not cross).
+      ContactParams params = base;
+      params.speculativeMargin = tuning::kSpeculativeMargin + (bodies_.linearVelocity[a] - bodies_.linearVelocity[b]).norm() * dt;
+      const BodyShape& sa = bodies_.shape[a];
+      const BodyShape& sb = bodies_.shape[b];
+      if (sa.isGrid() && sb.isGrid()) {
+        int smaller = 0;
+        collideGrids(*grids_[sa.grid], bodies_.shapePose(a), *grids_[sb.grid], bodies_.shapePose(b),
+                     scene_.settings.approximationDepth, params, scratch_[k], out, smaller, &pairStats_[k]);
+        pairFlipped_[k] = smaller == 1;  // normals point from the larger (a) to the smaller (b)
+      } else if (sa.isGrid() || sb.isGrid()) {
+        const uint32_t g = sa.isGrid() ? a : b, p = sa.isGrid() ? b : a;
+        grids_[bodies_.shape[g].grid]->collide(bodies_.shapePose(g), bodies_.shape[p].primitive, bodies_.shapePose(p), params,
+                                               scratch_[k], out, &pairStats_[k]);
+        pairFlipped_[k] = p == b;  // normals point from the grid towards the primitive
+      } else {
+        // Two primitives: in a frame at a's position (double -> float once, per the precision rule).
+        const RigidTransform frame{bodies_.position[a], Quatf::Identity()};
+        const RigidTransform pa = bodies_.shapePose(a), pb = bodies_.shapePose(b);
+        LocalContact c[kMaxContactsPerBrick];
+        const int m = collideShapes(sa.primitive, LocalPose{frame.pointToLocal(pa.translation), pa.rotation}, sb.primitive,
+                                    LocalPose{frame.pointToLocal(pb.translation), pb.rotation}, params.speculativeMargin, c);
+        for (int i = 0; i < m; ++i)
+          out.push_back({frame.pointToWorld(c[i].position), c[i].normal, c[i].depth, 0u, 0u});
+      }
+    }
+  });
+}
+
+const std::vector<std::vector<Contact>>& World::probeContacts(float lodFraction, int approximationDepth, int manifoldSize,
+                                                             uint64_t* boxTests) {
+  const SceneSettings saved = scene_.settings;
+  scene_.settings.lodFraction = lodFraction;
+  scene_.settings.approximationDepth = approximationDepth;
+  scene_.settings.manifoldSize = manifoldSize;
+  scene_.settings.reuseTranslation = 0;  // nothing counts as still: every pair is collided
+  try {
+    validateScene(scene_);
+    generateContacts(float(scene_.settings.timestep / scene_.settings.substeps));
+  } catch (...) {
+    scene_.settings = saved;
+    throw;
+  }
+  scene_.settings = saved;
+  if (boxTests) {
+    *boxTests = 0;
+    for (const ContactStats& s : pairStats_) *boxTests += s.index.boxTests;
+  }
+  return pairContacts_;
+}
+
+}  // namespace bw

@@ -1,0 +1,275 @@
+#include "world/contact_solver.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "world/world_tuning.h"
+
+namespace bw {
+
+using namespace tuning;
+
+void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs,
+                            const std::vector<std::vector<Contact>>& pairContacts, const std::vector<uint8_t>& flipped,
+                            const SceneSettings& settings, float dt) {
+  contacts_.clear();
+  inverseInertiaWorld_.resize(bodies.size());
+  for (uint32_t i = 0; i < bodies.size(); ++i) inverseInertiaWorld_[i] = bodies.inverseInertiaWorld(i);
+  for (uint32_t k = 0; k < pairs.size(); ++k) {
+    // Solver convention: the normal points from b towards a.
+    const uint32_t a = flipped[k] ? pairs[k].b : pairs[k].a;
+    const uint32_t b = flipped[k] ? pairs[k].a : pairs[k].b;
+    for (const Contact& c : pairContacts[k]) {
+      SolverContact s;
+      s.a = a;
+      s.b = b;
+      s.point = c.position;
+      s.normal = c.normal;
+      s.depth = c.depth;
+      s.pairKey = (uint64_t(pairs[k].a) << 32) | pairs[k].b;
+      s.feature = c.featureB;
+      s.rA = (c.position - bodies.position[a]).cast<float>();
+      s.rB = (c.position - bodies.position[b]).cast<float>();
+      const Vec3f n = s.normal;
+      s.t1 = (std::abs(n.x()) > kTangentThreshold ? Vec3f(n.y(), -n.x(), 0) : Vec3f(0, n.z(), -n.y())).normalized();
+      s.t2 = n.cross(s.t1);
+      const Mat3f& iA = inverseInertiaWorld_[a];
+      const Mat3f& iB = inverseInertiaWorld_[b];
+      const Vec3f dirs[3] = {n, s.t1, s.t2};
+      float masses[3];
+      for (int d = 0; d < 3; ++d) {
+        s.angA[d] = iA * s.rA.cross(dirs[d]);
+        s.angB[d] = iB * s.rB.cross(dirs[d]);
+        const float m = bodies.inverseMass[a] + bodies.inverseMass[b] + s.angA[d].cross(s.rA).dot(dirs[d]) +
+                        s.angB[d].cross(s.rB).dot(dirs[d]);
+        masses[d] = m > 0 ? 1.f / m : 0.f;
+      }
+      s.massN = masses[0];
+      s.massT1 = masses[1];
+      s.massT2 = masses[2];
+      if (settings.shockPropagation && bodies.motion[a] == MotionType::Dynamic && bodies.motion[b] == MotionType::Dynamic) {
+        // The lower body (along gravity) is the support: in the shock sweep only the upper one moves.
+        const Vec3d up = -settings.gravity.normalized();
+        const double ha = up.dot(bodies.position[a]), hb = up.dot(bodies.position[b]);
+        if (std::isfinite(ha) && std::abs(ha - hb) > kShockHeightEpsilon) {
+          s.shockLower = ha < hb ? 1 : 2;
+          s.height = std::min(ha, hb);
+          for (int d = 0; d < 3; ++d) {
+            const float m = s.shockLower == 1 ? bodies.inverseMass[b] + s.angB[d].cross(s.rB).dot(dirs[d])
+                                              : bodies.inverseMass[a] + s.angA[d].cross(s.rA).dot(dirs[d]);
+            s.shockMass[d] = m > 0 ? 1.f / m : 0.f;
+          }
+        }
+      }
+      s.friction = std::sqrt(bodies.friction[a] * bodies.friction[b]);
+      const Vec3f vRel = bodies.linearVelocity[a] + bodies.angularVelocity[a].cross(s.rA) - bodies.linearVelocity[b] -
+                         bodies.angularVelocity[b].cross(s.rB);
+      const float vn = vRel.dot(n);
+      // Penetrating: push out (Baumgarte) and restitute fast impacts. Speculative (a gap of -depth):
+      // the bodies may approach by at most the gap this step.
+      const float bounce = vn < -kBounceThreshold ? -kRestitution * vn : 0.f;
+      s.bias = s.depth >= 0.f ? std::min(kBaumgarte / dt * std::max(s.depth - kSlop, 0.f), kMaxPushOut) + bounce : s.depth / dt;
+      // The relax pass after integration keeps restitution and speculative gaps but drops the
+      // push-out, so no push-out velocity survives into the next step (resting stacks stay put).
+      s.relaxBias = s.depth >= 0.f ? bounce : s.depth / dt;
+      // Warm start from the nearest cached impulse of the same pair and feature.
+      const CachedImpulse key{s.pairKey, s.feature, {}, 0, 0, 0};
+      auto range = std::equal_range(cache_.begin(), cache_.end(), key);
+      double best = kWarmStartRadius * kWarmStartRadius;
+      for (auto it = range.first; it != range.second; ++it) {
+        const double d2 = (it->point - s.point).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          s.lambdaN = it->n;
+          s.lambdaT1 = it->t1;
+          s.lambdaT2 = it->t2;
+        }
+      }
+      contacts_.push_back(s);
+    }
+  }
+}
+
+// Applies impulse `lambda` along direction d (0 normal, 1 and 2 tangents) to the contact's
+// dynamic bodies (static and kinematic bodies are read, never written).
+void ContactSolver::applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda) {
+  SolverBody& a = bodies_[s.a];
+  SolverBody& b = bodies_[s.b];
+  if (a.dynamic) {
+    a.v += dir * (lambda * a.invMass);
+    a.w += s.angA[d] * lambda;
+  }
+  if (b.dynamic) {
+    b.v -= dir * (lambda * b.invMass);
+    b.w -= s.angB[d] * lambda;
+  }
+}
+
+void ContactSolver::loadBodies(const BodyStore& bodies) {
+  const uint32_t n = bodies.size();
+  bodies_.resize(n);
+  for (uint32_t i = 0; i < n; ++i)
+    bodies_[i] = {bodies.linearVelocity[i], bodies.inverseMass[i], bodies.angularVelocity[i],
+                  bodies.motion[i] == MotionType::Dynamic ? 1u : 0u};
+}
+
+void ContactSolver::storeBodies(BodyStore& bodies) const {
+  for (uint32_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies_[i].dynamic) continue;
+    bodies.linearVelocity[i] = bodies_[i].v;
+    bodies.angularVelocity[i] = bodies_[i].w;
+  }
+}
+
+void ContactSolver::warmStart(const SolverContact& s) {
+  applyImpulse(s, 0, s.normal, s.lambdaN);
+  applyImpulse(s, 1, s.t1, s.lambdaT1);
+  applyImpulse(s, 2, s.t2, s.lambdaT2);
+}
+
+// One Gauss-Seidel update of one contact: normal impulse clamped at zero, then friction
+// clamped by the Coulomb bound.
+void ContactSolver::solveContact(SolverContact& s, bool relax) {
+  const SolverBody& a = bodies_[s.a];
+  const SolverBody& b = bodies_[s.b];
+  auto relative = [&] { return Vec3f(a.v + a.w.cross(s.rA) - b.v - b.w.cross(s.rB)); };
+  const float oldN = s.lambdaN;
+  s.lambdaN = std::max(oldN + s.massN * ((relax ? s.relaxBias : s.bias) - relative().dot(s.normal)), 0.f);
+  applyImpulse(s, 0, s.normal, s.lambdaN - oldN);
+  const float limit = s.friction * s.lambdaN;
+  const Vec3f v = relative();
+  const float o1 = s.lambdaT1, o2 = s.lambdaT2;
+  s.lambdaT1 = std::clamp(o1 - s.massT1 * v.dot(s.t1), -limit, limit);
+  s.lambdaT2 = std::clamp(o2 - s.massT2 * v.dot(s.t2), -limit, limit);
+  applyImpulse(s, 1, s.t1, s.lambdaT1 - o1);
+  applyImpulse(s, 2, s.t2, s.lambdaT2 - o2);
+}
+
+// Shock propagation (Guendelman et al.): after the iterations, one sweep from the bottom of the
+// pile up in which each contact treats its lower body as immovable, so a heavy body cannot push
+// a light one below it into the ground (the 1000:1 mass-ratio stack). Only the upper body's
+// velocity changes; the accumulated impulses keep their clamps.
+void ContactSolver::solveContactShock(SolverContact& s) {
+  SolverBody& a = bodies_[s.a];
+  SolverBody& b = bodies_[s.b];
+  SolverBody& upper = s.shockLower == 1 ? b : a;
+  auto relative = [&] { return Vec3f(a.v + a.w.cross(s.rA) - b.v - b.w.cross(s.rB)); };
+  // Impulse along dir on the upper body only (a receives +, b receives -).
+  auto push = [&](int d, const Vec3f& dir, float lambda) {
+    if (s.shockLower == 1) {
+      upper.v -= dir * (lambda * upper.invMass);
+      upper.w -= s.angB[d] * lambda;
+    } else {
+      upper.v += dir * (lambda * upper.invMass);
+      upper.w += s.angA[d] * lambda;
+    }
+  };
+  const float oldN = s.lambdaN;
+  s.lambdaN = std::max(oldN + s.shockMass[0] * (s.bias - relative().dot(s.normal)), 0.f);
+  push(0, s.normal, s.lambdaN - oldN);
+  const float limit = s.friction * s.lambdaN;
+  const Vec3f v = relative();
+  const float o1 = s.lambdaT1, o2 = s.lambdaT2;
+  s.lambdaT1 = std::clamp(o1 - s.shockMass[1] * v.dot(s.t1), -limit, limit);
+  s.lambdaT2 = std::clamp(o2 - s.shockMass[2] * v.dot(s.t2), -limit, limit);
+  push(1, s.t1, s.lambdaT1 - o1);
+  push(2, s.t2, s.lambdaT2 - o2);
+}
+
+// The island's contacts bottom-up (by the lower body's height, ties by index: deterministic):
+// contacts with a static or kinematic body first (they are the ground), then dynamic pairs.
+void ContactSolver::shockSweep(std::vector<uint32_t>& list) {
+  std::stable_sort(list.begin(), list.end(), [&](uint32_t x, uint32_t y) {
+    const SolverContact& p = contacts_[x];
+    const SolverContact& q = contacts_[y];
+    if ((p.shockLower == 0) != (q.shockLower == 0)) return p.shockLower == 0;
+    return p.height < q.height;
+  });
+  for (uint32_t k : list) {
+    if (contacts_[k].shockLower)
+      solveContactShock(contacts_[k]);
+    else
+      solveContact(contacts_[k], false);  // against the ground (or side by side): a normal update
+  }
+}
+
+
+void ContactSolver::solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings) {
+  const uint32_t n = uint32_t(island.size());
+  if (!relax)
+    for (uint32_t k : island) warmStart(contacts_[k]);
+  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
+  for (int it = 0; it < iterations; ++it) {
+    // note: sweeps alternate direction (symmetric Gauss-Seidel) so no contact is always solved
+    // last; a fixed order makes friction in stacks creep one way.
+    for (uint32_t j = 0; j < n; ++j) solveContact(contacts_[island[(it & 1) ? n - 1 - j : j]], relax);
+  }
+  if (!relax && settings.shockPropagation) {
+    thread_local std::vector<uint32_t> list;  // note: per worker thread, reused across islands
+    list.assign(island.begin(), island.end());
+    shockSweep(list);
+  }
+}
+
+// One big island (a pile) on every thread: colour by colour, each colour's contacts in parallel.
+// Iterations alternate the colour order like solveIsland alternates the contact order.
+void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, const std::vector<MotionType>& motion, bool relax,
+                                         const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage) {
+  colouring_.colour(island, contacts_, motion);
+  const uint32_t colours = colouring_.colours();
+  if (!relax)
+    for (uint32_t c : colouring_.all()) warmStart(contacts_[c]);
+  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
+  for (int it = 0; it < iterations; ++it) {
+    for (uint32_t i = 0; i < colours; ++i) {
+      const uint32_t c = (it & 1) ? colours - 1 - i : i;
+      const std::span<const uint32_t> group = colouring_.colour(c);
+      if (c == kMaxColours) {  // the serial group: contacts may share bodies
+        for (uint32_t k : group) solveContact(contacts_[k], relax);
+        continue;
+      }
+      jobs.parallelFor(0, uint32_t(group.size()), kColourGrain, [&](uint32_t cb, uint32_t ce) {
+        ProfileZone zone(profiler, "colour", stage + (relax ? 5 : 3));
+        for (uint32_t j = cb; j < ce; ++j) solveContact(contacts_[group[j]], relax);
+      });
+    }
+  }
+  if (!relax && settings.shockPropagation) {  // one serial sweep over the whole pile
+    std::vector<uint32_t> list(colouring_.all().begin(), colouring_.all().end());
+    shockSweep(list);
+  }
+}
+
+SolveStats ContactSolver::solve(const Islands& islands, const std::vector<MotionType>& motion, bool relax,
+                                const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage) {
+  // Islands touch disjoint dynamic bodies: solving them in parallel is race-free and gives the
+  // same result as solving them one by one. Islands above kSplitContacts are split by colour
+  // instead (first, one at a time, each on every thread); which islands are split depends only
+  // on their size, so the result does not depend on the thread count.
+  SolveStats stats;
+  smallIslands_.clear();
+  for (uint32_t i = 0; i < islands.count(); ++i) {
+    const uint32_t size = uint32_t(islands.contacts(i).size());
+    stats.largestIsland = std::max(stats.largestIsland, size);
+    if (size > kSplitContacts) {
+      solveIslandInColours(islands.contacts(i), motion, relax, settings, jobs, profiler, stage);
+      ++stats.splitIslands;
+    } else {
+      smallIslands_.push_back(i);
+    }
+  }
+  jobs.parallelFor(0, uint32_t(smallIslands_.size()), 1, [&](uint32_t b, uint32_t e) {
+    ProfileZone zone(profiler, relax ? "relax" : "island", stage + (relax ? 5 : 3));
+    for (uint32_t i = b; i < e; ++i) solveIsland(islands.contacts(smallIslands_[i]), relax, settings);
+  });
+  if (relax) {
+    // The final impulses warm-start the next substep.
+    nextCache_.clear();
+    for (const SolverContact& s : contacts_) nextCache_.push_back({s.pairKey, s.feature, s.point, s.lambdaN, s.lambdaT1, s.lambdaT2});
+    std::stable_sort(nextCache_.begin(), nextCache_.end());
+    std::swap(cache_, nextCache_);
+  }
+  return stats;
+}
+
+}  // namespace bw

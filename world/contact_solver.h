@@ -1,0 +1,69 @@
+#pragma once
+/// The sequential-impulse contact solver: friction (Coulomb, two tangents), restitution above
+/// a speed threshold, Baumgarte push-out with slop and a speed cap, speculative gaps, warm
+/// starting matched by pair, feature and position, optional shock propagation, and a relax
+/// pass without push-out. Islands are solved in parallel; a large island colour by colour on
+/// every thread. The result does not depend on the thread count.
+///
+///   solver.prepare(bodies, pairs, pairContacts, flipped, settings, dt);
+///   islands.build(solver.contacts(), bodies.motion);
+///   solver.loadBodies(bodies); solver.solve(islands, false, ...); solver.storeBodies(bodies);
+#include <cstdint>
+#include <vector>
+
+#include "collision/bricks/contact.h"
+#include "jobs/job_system.h"
+#include "jobs/profiler.h"
+#include "world/body_store.h"
+#include "world/broadphase.h"
+#include "world/islands.h"
+#include "world/scene_description.h"
+#include "world/solver_contact.h"
+
+namespace bw {
+
+/// Figures of one solve().
+struct SolveStats {
+  uint32_t largestIsland = 0;  ///< contacts in the largest island
+  uint32_t splitIslands = 0;   ///< islands solved colour by colour on every thread
+};
+
+class ContactSolver {
+ public:
+  /// This substep's solver contacts from the pairs' contacts (pair k's normals point from the
+  /// pair's a side to its b side unless flipped[k]), with effective masses, biases and the
+  /// warm-start impulses of the previous substep.
+  void prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs, const std::vector<std::vector<Contact>>& pairContacts,
+               const std::vector<uint8_t>& flipped, const SceneSettings& settings, float dt);
+  const std::vector<SolverContact>& contacts() const { return contacts_; }
+
+  /// Copies the bodies' velocities into the solver's compact records, and back (dynamic only).
+  void loadBodies(const BodyStore& bodies);
+  void storeBodies(BodyStore& bodies) const;
+
+  /// Warm start (not when relaxing) and iterate every island: islands above kSplitContacts
+  /// first, one at a time, colour by colour on every thread; then the others whole, in
+  /// parallel. `relax`: the pass after integration, without push-out, which also keeps the
+  /// final impulses for the next substep's warm start. `stage` is the profiling stage id.
+  SolveStats solve(const Islands& islands, const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
+                   JobSystem& jobs, Profiler& profiler, int stage);
+
+ private:
+  void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
+  void warmStart(const SolverContact& s);
+  void solveContact(SolverContact& s, bool relax);
+  void solveContactShock(SolverContact& s);
+  void shockSweep(std::vector<uint32_t>& contacts);
+  void solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings);
+  void solveIslandInColours(std::span<const uint32_t> island, const std::vector<MotionType>& motion, bool relax,
+                            const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage);
+
+  std::vector<SolverContact> contacts_;
+  std::vector<SolverBody> bodies_;
+  std::vector<Mat3f> inverseInertiaWorld_;  // per body, this substep
+  std::vector<CachedImpulse> cache_, nextCache_;
+  std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
+  IslandColouring colouring_;               // of the large island being solved
+};
+
+}  // namespace bw

@@ -1,0 +1,63 @@
+#include "world/ray_load.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "collision/core/hash.h"
+#include "collision/core/seeded_random.h"
+#include "world/world_tuning.h"
+
+namespace bw {
+
+RayLoadStats RayLoad::fire(const RayLoadDescription& load, uint32_t frame, const BodyStore& bodies,
+                           const std::vector<std::unique_ptr<BrickGrid>>& grids, const std::vector<WorldAabb>& bounds,
+                           JobSystem& jobs, Profiler& profiler, int stage) {
+  RayLoadStats stats;
+  rays_.clear();
+  hitT_.clear();
+  if (load.count == 0) return stats;
+  Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  gridBodies_.clear();
+  for (uint32_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies.shape[i].isGrid() || bodies.motion[i] == MotionType::Dynamic) continue;
+    gridBodies_.push_back(i);
+    lo = lo.cwiseMin(bounds[i].min);
+    hi = hi.cwiseMax(bounds[i].max);
+  }
+  if (gridBodies_.empty()) return stats;
+  rays_.assign(load.count, LoadRay{});
+  hitT_.assign(load.count, std::numeric_limits<float>::infinity());
+  stats_.assign(load.count, QueryStats{});
+  const uint64_t seed = load.seed ^ (uint64_t(frame) * kGoldenGamma);
+  jobs.parallelFor(0, load.count, tuning::kRayGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler, "rays", stage);
+    for (uint32_t k = begin; k < end; ++k) {
+      SeededRandom r(seed + k);
+      const Vec3d from(r.uniform(lo.x(), hi.x()), r.uniform(lo.y(), hi.y()), r.uniform(lo.z(), hi.z()));
+      const Vec3d to(r.uniform(lo.x(), hi.x()), r.uniform(lo.y(), hi.y()), r.uniform(lo.z(), hi.z()));
+      const double span = (to - from).norm();
+      rays_[k].from = from;
+      if (span == 0) continue;
+      const Vec3d dir = (to - from) / span;
+      const double length = load.length > 0 ? double(load.length) : (hi - lo).norm();
+      rays_[k].direction = dir;
+      rays_[k].length = length;
+      for (uint32_t body : gridBodies_) {
+        const RigidTransform pose = bodies.shapePose(body);
+        const Ray ray = Ray::make(pose.pointToLocal(from), pose.directionToLocal(Vec3f(dir.cast<float>())),
+                                  std::min(float(length), hitT_[k]));
+        const GridRayHit hit = grids[bodies.shape[body].grid]->raycast(ray, ~0u, &stats_[k]);
+        if (hit.hit()) hitT_[k] = hit.t;
+      }
+    }
+  });
+  stats.rays = load.count;
+  for (uint32_t k = 0; k < load.count; ++k) {
+    stats.hits += std::isfinite(hitT_[k]) ? 1u : 0u;
+    stats.boxTests += stats_[k].boxTests;
+  }
+  return stats;
+}
+
+}  // namespace bw
