@@ -25,17 +25,19 @@ struct BodyShape {
   bool isTerrain() const { return terrain != kInvalidIndex; }
 };
 
+/// Every body of a world, one array per field (index = body id). SI units: metres, seconds,
+/// kilograms, radians.
 struct BodyStore {
-  std::vector<Vec3d> position;            // centre of mass, world
-  std::vector<Quatf> rotation;            // principal frame, world
-  std::vector<Vec3f> linearVelocity;
-  std::vector<Vec3f> angularVelocity;     // world frame
-  std::vector<float> inverseMass;
-  std::vector<Vec3f> inverseInertia;      // principal, body frame
+  std::vector<Vec3d> position;            ///< m, world: a dynamic body's centre of mass, else its shape's origin
+  std::vector<Quatf> rotation;            ///< world orientation of the body frame (principal axes for dynamic grids)
+  std::vector<Vec3f> linearVelocity;      ///< m/s, world
+  std::vector<Vec3f> angularVelocity;     ///< rad/s, world frame
+  std::vector<float> inverseMass;         ///< 1/kg; 0 for static and kinematic bodies
+  std::vector<Vec3f> inverseInertia;      ///< 1/(kg m^2), principal, body frame; 0 when not dynamic
   std::vector<MotionType> motion;
   std::vector<BodyShape> shape;
-  std::vector<RigidTransform> shapeFromBody;  // shape frame expressed in the body frame
-  std::vector<float> friction;
+  std::vector<RigidTransform> shapeFromBody;  ///< the shape's frame expressed in the body frame
+  std::vector<float> friction;            ///< Coulomb coefficient; a pair uses sqrt(fa * fb)
 
   uint32_t size() const { return uint32_t(position.size()); }
   /// Appends a body; returns its id.

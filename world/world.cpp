@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include "collision/core/argument_checks.h"
 #include "collision/core/hash.h"
 #include "world/scene_validation.h"
 
@@ -21,6 +22,20 @@ World::World(const SceneDescription& scene, int threads) : scene_((validateScene
   for (const TerrainDescription& t : scene_.terrains) buildTerrain(t);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
   sleep_.reset(bodies_.size());
+}
+
+const BrickGrid& World::grid(uint32_t index) const {
+  if (index >= grids_.size())
+    throw InvalidInput("World::grid: index is " + std::to_string(index) + ", the world has " + std::to_string(grids_.size()) + " grids");
+  return *grids_[index];
+}
+
+BrickGrid& World::editGrid(uint32_t index) {
+  if (index >= grids_.size())
+    throw InvalidInput("World::editGrid: index is " + std::to_string(index) + ", the world has " + std::to_string(grids_.size()) +
+                       " grids");
+  editedGrids_.push_back(index);
+  return *grids_[index];
 }
 
 uint64_t World::brickCount() const {

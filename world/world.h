@@ -57,25 +57,33 @@ class World {
   /// Builds everything the scene declares. Throws InvalidInput / SceneError on bad content.
   World(const SceneDescription& scene, int threads);
 
-  /// One frame (settings.timestep), in settings.substeps substeps.
+  /// One frame (settings.timestep seconds), in settings.substeps substeps.
   void step();
+  /// Frames stepped so far.
   uint32_t frame() const { return frame_; }
+  /// Every body, SoA (units in body_store.h). Read between steps.
   const BodyStore& bodies() const { return bodies_; }
+  /// Figures of the last step (times in ms, counts summed over its substeps).
   const StepStats& lastStats() const { return stats_; }
+  /// The scene as validated and built.
   const SceneDescription& scene() const { return scene_; }
+  /// Profiling zones of the steps (Chrome trace, work/span).
   Profiler& profiler() { return profiler_; }
+  /// Bricks in all grids (a grid shared by several bodies counts once).
   uint64_t brickCount() const;
-  /// The world's grids (shared by every body that is a copy of them).
-  const BrickGrid& grid(uint32_t index) const { return *grids_[index]; }
-  /// A grid to edit (place or remove bricks) between steps; every body using it sees the edit
-  /// at the next step. Not while step() runs.
-  BrickGrid& editGrid(uint32_t index) {
-    editedGrids_.push_back(index);
-    return *grids_[index];
-  }
-  /// Hash of every body's position, rotation and velocities (bit patterns).
+  /// Grids in the world, in scene order (spawned grid copies share their template's grid).
+  uint32_t gridCount() const { return uint32_t(grids_.size()); }
+  /// Grid `index` (< gridCount(), else InvalidInput), shared by every body that is a copy of it.
+  const BrickGrid& grid(uint32_t index) const;
+  /// Grid `index` (< gridCount(), else InvalidInput) to edit: place or remove bricks between
+  /// steps; every body using it sees the edit at the next step, bodies resting on it wake and
+  /// its cached contacts are dropped. Not while step() runs.
+  BrickGrid& editGrid(uint32_t index);
+  /// Hash of every body's position, rotation and velocities (bit patterns): equal hashes mean
+  /// bit-identical states. The same for any thread count.
   uint64_t stateHash() const;
-  /// Kinetic plus potential energy of the dynamic bodies (for drift checks).
+  /// Kinetic plus gravitational potential energy of the dynamic bodies, in joules (kg m^2/s^2;
+  /// potential measured from the world origin along gravity), for drift checks.
   double energy() const;
   /// Pairs of the last substep and each pair's contacts (normal from the pair's `a` side to
   /// its `b` side unless pairContactsFlipped(k)); for tests and tools.

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "collision/core/assert.h"
 #include "collision/core/obb.h"
 #include "collision/core/ray.h"
 #include "collision/core/virtual_pool.h"
@@ -72,12 +73,26 @@ class OctoBvh {
   void clear();
 
   // ---- element access ----
+  /// Live elements.
   uint32_t size() const { return elements_.size(); }
   bool empty() const { return elements_.size() == 0; }
+  /// Whether `handle` names a live element (any value may be asked).
   bool contains(uint32_t handle) const { return elements_.isLive(handle); }
-  Aabb bounds(uint32_t handle) const { return elements_[handle].bounds(); }
-  uint32_t filter(uint32_t handle) const { return elements_[handle].filter; }
-  uint32_t payload(uint32_t handle) const { return elements_[handle].payload; }
+  /// A live element's bounds, filter bits and payload, as inserted or last updated.
+  /// Precondition: contains(handle) (checked by BW_ASSERT in debug and sanitizer builds; a dead
+  /// handle's slot holds whatever the pool left there).
+  Aabb bounds(uint32_t handle) const {
+    BW_ASSERT(contains(handle));
+    return elements_[handle].bounds();
+  }
+  uint32_t filter(uint32_t handle) const {
+    BW_ASSERT(contains(handle));
+    return elements_[handle].filter;
+  }
+  uint32_t payload(uint32_t handle) const {
+    BW_ASSERT(contains(handle));
+    return elements_[handle].payload;
+  }
   /// Tight bounds of everything (empty box when the tree is empty).
   Aabb rootBounds() const { return clusters_[rootCluster_].bounds(0); }
   /// Level of the root cube: it spans [-2^(level-1), 2^(level-1)).
