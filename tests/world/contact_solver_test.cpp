@@ -1,0 +1,83 @@
+// The contact solver on hand-built bodies: warm starting matches impulses by pair and feature
+// at full width (ids above 2^20 do not collide), and a resting box's impulse carries over.
+#include <gtest/gtest.h>
+
+#include "world/contact_solver.h"
+
+namespace bw {
+namespace {
+
+// A static ground (body 0) and two dynamic unit boxes (bodies 1 and 2) resting on it.
+BodyStore groundAndTwoBoxes() {
+  BodyStore bodies;
+  bodies.add(Vec3d::Zero(), Quatf::Identity(), MotionType::Static, BodyShape{}, 0.f, Vec3f::Zero());
+  for (double x : {0.0, 5.0}) {
+    const uint32_t id = bodies.add(Vec3d(x, 0, 0.5), Quatf::Identity(), MotionType::Dynamic, BodyShape{}, 1.f, Vec3f::Constant(6.f));
+    bodies.linearVelocity[id] = Vec3f(0, 0, -1);  // pressing into the ground
+  }
+  return bodies;
+}
+
+// One solve of the given pairs, each with one contact under its box, ending with the relax
+// pass that stores the impulses for the next substep's warm start.
+void solveOnce(ContactSolver& solver, BodyStore& bodies, const std::vector<BodyPair>& pairs,
+               const std::vector<uint32_t>& features, JobSystem& jobs, Profiler& profiler) {
+  SceneSettings settings;
+  std::vector<std::vector<Contact>> contacts;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const Vec3d under = bodies.position[pairs[k].b] - Vec3d(0, 0, 0.5);
+    contacts.push_back({Contact{under, Vec3f::UnitZ(), 0.001f, features[k], 0}});
+  }
+  const std::vector<uint8_t> flipped(pairs.size(), 1);  // normal from the ground (a) to the box (b)
+  solver.prepare(bodies, pairs, contacts, flipped, settings, 1.f / 60);
+  Islands islands;
+  islands.build(solver.contacts(), bodies.motion);
+  solver.loadBodies(bodies);
+  solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
+  solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);
+  solver.storeBodies(bodies);
+}
+
+TEST(ContactSolver, WarmStartMatchesPairAndFeatureAtFullWidth) {
+  JobSystem jobs(1);
+  Profiler profiler;
+  BodyStore bodies = groundAndTwoBoxes();
+  ContactSolver solver;
+  // Substep 1: pair (0, 1) with feature 0. Under a packed key (a << 40) ^ (b << 20) ^ feature
+  // it reads 1 << 20, the same as pair (0, 2) with feature 3 << 20 (brick ids above 2^20).
+  solveOnce(solver, bodies, {{0, 1}}, {0u}, jobs, profiler);
+  ASSERT_EQ(solver.contacts().size(), 1u);
+  ASSERT_GT(solver.contacts()[0].lambdaN, 0.f) << "the box pressing down must get a normal impulse";
+
+  // Substep 2, same point: pair (0, 1) again warm-starts from its own impulse (the control),
+  // while pair (0, 2) with the colliding feature must start cold.
+  bodies.position[2] = bodies.position[1];
+  SceneSettings settings;
+  const std::vector<BodyPair> pairs = {{0, 1}, {0, 2}};
+  std::vector<std::vector<Contact>> contacts = {{Contact{Vec3d(0, 0, 0), Vec3f::UnitZ(), 0.001f, 0u, 0}},
+                                                {Contact{Vec3d(0, 0, 0), Vec3f::UnitZ(), 0.001f, 3u << 20, 0}}};
+  solver.prepare(bodies, pairs, contacts, std::vector<uint8_t>(2, 1), settings, 1.f / 60);
+  ASSERT_EQ(solver.contacts().size(), 2u);
+  EXPECT_GT(solver.contacts()[0].lambdaN, 0.f) << "same pair and feature: warm-started";
+  EXPECT_EQ(solver.contacts()[1].lambdaN, 0.f) << "another pair whose packed key would collide: cold";
+  EXPECT_EQ(solver.contacts()[1].lambdaT1, 0.f);
+  EXPECT_EQ(solver.contacts()[1].lambdaT2, 0.f);
+}
+
+TEST(ContactSolver, WarmStartKeepsFeaturesAboveTwoToTheTwentyApart) {
+  JobSystem jobs(1);
+  Profiler profiler;
+  BodyStore bodies = groundAndTwoBoxes();
+  ContactSolver solver;
+  // Brick ids 5 and 5 + 2^20 on the same pair are different bricks.
+  solveOnce(solver, bodies, {{0, 1}}, {5u}, jobs, profiler);
+  ASSERT_GT(solver.contacts()[0].lambdaN, 0.f);
+  SceneSettings settings;
+  const Vec3d under = bodies.position[1] - Vec3d(0, 0, 0.5);
+  std::vector<std::vector<Contact>> contacts = {{Contact{under, Vec3f::UnitZ(), 0.001f, 5u + (1u << 20), 0}}};
+  solver.prepare(bodies, {{0, 1}}, contacts, std::vector<uint8_t>(1, 1), settings, 1.f / 60);
+  EXPECT_EQ(solver.contacts()[0].lambdaN, 0.f);
+}
+
+}  // namespace
+}  // namespace bw
