@@ -26,6 +26,7 @@
 #include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/broadphase.h"
+#include "world/containment.h"
 #include "world/contact_solver.h"
 #include "world/islands.h"
 #include "world/pair_cache.h"
@@ -99,6 +100,12 @@ class World {
                                                          uint64_t* boxTests = nullptr);
   /// Dynamic bodies currently asleep.
   uint32_t sleepingCount() const { return sleep_.count(); }
+  /// Whether point `p` (world) is inside a brick of any grid body but `self`, or in a solid
+  /// terrain voxel (containment.h).
+  InsideSolid pointInsideSolid(const Vec3d& p, uint32_t self) const;
+  /// Whether the segment from `from` to `to` (world) crosses a static or kinematic grid or a
+  /// terrain. Fills terrain chunk caches as rays do, so not while step() runs.
+  bool segmentHitsStatic(const Vec3d& from, const Vec3d& to);
   /// The scene's ray load of the last frame: its rays and their closest hits (empty without one).
   const RayLoad& rayLoad() const { return rayLoad_; }
 

@@ -105,15 +105,18 @@ int runScene(const SceneRunOptions& o) {
   if (!o.csvPath.empty()) {
     csv.open(o.csvPath);
     if (!csv) throw std::runtime_error("cannot write " + o.csvPath);
-    csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,rays_ms,pairs,contacts,box_tests,ray_hits\n";
+    csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,rays_ms,pairs,contacts,box_tests,ray_hits,"
+           "bodies_inside_solid\n";
   }
   double work = 0, span = 0;
   std::vector<Vec3d> settled;  // positions at --drift-after
+  ContainmentTracker containment(world);  // updated after each step, outside its timing
   const auto tRun = Clock::now();
   for (uint32_t f = 0; f < frames; ++f) {
     if (o.driftAfter && f == o.driftAfter) settled = world.bodies().position;
     world.step();
     const StepStats& s = world.lastStats();
+    containment.update();
     total.v.push_back(s.totalMs);
     broad.v.push_back(s.broadphaseMs);
     contacts.v.push_back(s.contactsMs);
@@ -133,7 +136,7 @@ int runScene(const SceneRunOptions& o) {
     reused += s.pairsReused;
     if (csv) csv << f << "," << s.totalMs << "," << s.broadphaseMs << "," << s.contactsMs << "," << s.solverMs << ","
                  << s.integrateMs << "," << s.raysMs << "," << s.pairs << "," << s.contacts << "," << s.boxTests << "," << s.rayHits
-                 << "\n";
+                 << "," << containment.report().count() << "\n";
     if (o.progress && !o.json && frames >= 100 && (f + 1) % (frames / 10) == 0)
       std::fprintf(stderr, "  frame %u/%u  %.2f ms\n", f + 1, frames, s.totalMs);
   }
@@ -156,6 +159,8 @@ int runScene(const SceneRunOptions& o) {
     (bodies.linearVelocity[i].norm() < 0.05f && bodies.angularVelocity[i].norm() < 0.1f ? resting : moving)++;
     lowest = std::min(lowest, bodies.position[i].z());
   }
+  // Bodies that ended inside solid (in a brick, in a solid voxel, or under a surface they passed).
+  const ContainmentReport& inside = containment.report();
   double drift = 0;
   for (uint32_t i = 0; i < settled.size(); ++i)
     if (bodies.motion[i] == MotionType::Dynamic) drift = std::max(drift, (bodies.position[i] - settled[i]).norm());
@@ -184,7 +189,14 @@ int runScene(const SceneRunOptions& o) {
                      {"dynamic_asleep", world.sleepingCount()},
                      {"dynamic_moving", moving},
                      {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
+                     {"bodies_inside_solid", inside.count()},
                      {"state_hash", world.stateHash()}};
+    if (inside.count()) {
+      nlohmann::json list = nlohmann::json::array();
+      for (uint32_t k = 0; k < inside.count() && k < 20; ++k)
+        list.push_back({{"body", inside.bodies[k]}, {"why", insideSolidName(inside.reasons[k])}, {"position", {bodies.position[inside.bodies[k]].x(), bodies.position[inside.bodies[k]].y(), bodies.position[inside.bodies[k]].z()}}});
+      j["inside_solid"] = list;
+    }
     if (!settled.empty()) j["drift_after_frame"] = {{"frame", o.driftAfter}, {"max_displacement_m", drift}};
     if (!scene.terrains.empty()) {
       j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
@@ -225,6 +237,11 @@ int runScene(const SceneRunOptions& o) {
     std::printf("  terrain: %.0f contacts per frame, %u bodies in water at the end\n", double(terrainContacts) / frames, floating);
   std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
               world.sleepingCount(), moving, std::isfinite(lowest) ? lowest : 0.0);
+  std::printf("  bodies inside solid at the end: %u\n", inside.count());
+  for (uint32_t k = 0; k < inside.count() && k < 5; ++k) {
+    const Vec3d& p = bodies.position[inside.bodies[k]];
+    std::printf("    body %u at (%.2f, %.2f, %.2f): %s\n", inside.bodies[k], p.x(), p.y(), p.z(), insideSolidName(inside.reasons[k]));
+  }
   if (!settled.empty())
     std::printf("  drift: largest displacement of a dynamic body from frame %u to the end %.3f mm\n", o.driftAfter, drift * 1e3);
   std::printf("  peak memory %.0f MiB; state hash %016llx\n", peakResidentMiB(), (unsigned long long)world.stateHash());

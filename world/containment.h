@@ -1,0 +1,62 @@
+#pragma once
+/// Containment: which dynamic bodies are inside solid. A run that ends with a body inside solid
+/// is wrong however fast it is, so every scene run reports the count (`bodies_inside_solid`).
+///
+/// A body is inside solid when its centre is inside a brick's exact shape (of any grid but its
+/// own) or a solid terrain voxel, or when it went through a surface: the straight path from the
+/// last place it was seen outside solid to where it is now crosses a static or kinematic grid
+/// or a terrain (a crate that tunnelled through a street plate stays counted while the plate
+/// is between it and where it came from; one pushed back out the way it came is clear again).
+/// A centre never reaches a surface legitimately: bodies rest with their centre a half extent
+/// or radius away from it.
+///
+///   ContainmentTracker tracker(world);
+///   for (...) { world.step(); tracker.update(); }
+///   tracker.report().count();
+#include <cstdint>
+#include <vector>
+
+#include "collision/core/math_types.h"
+
+namespace bw {
+
+class World;
+
+/// Why a body counts as inside solid.
+enum class InsideSolid : uint8_t {
+  No,
+  InBrick,       ///< its centre is inside a brick's exact shape
+  InVoxel,       ///< its centre is inside a solid terrain voxel
+  WentThrough,   ///< its path from the last place outside solid crosses a surface
+};
+
+const char* insideSolidName(InsideSolid reason);
+
+/// The dynamic bodies inside solid (ids ascending) and why.
+struct ContainmentReport {
+  std::vector<uint32_t> bodies;
+  std::vector<InsideSolid> reasons;
+  uint32_t count() const { return uint32_t(bodies.size()); }
+};
+
+/// Follows every dynamic body from frame to frame (call update() after each step; the world's
+/// bodies must not be added or removed in between). Not while step() runs: it casts rays into
+/// the terrains, which fill their chunk caches.
+class ContainmentTracker {
+ public:
+  /// Takes every dynamic body's current centre as its starting place (a body that starts
+  /// inside solid is reported as such).
+  explicit ContainmentTracker(World& world);
+  /// Checks every dynamic body that moved since the last update; returns the report.
+  const ContainmentReport& update();
+  const ContainmentReport& report() const { return report_; }
+
+ private:
+  World& world_;
+  std::vector<Vec3d> lastSeen_;   // per body: centre at the last update
+  std::vector<Vec3d> lastClear_;  // per body: the last centre seen outside solid
+  std::vector<InsideSolid> state_;
+  ContainmentReport report_;
+};
+
+}  // namespace bw
