@@ -8,6 +8,13 @@
 
 namespace bw {
 
+float World::closingSpeed(uint32_t a, uint32_t b) const {
+  // Relative speed of the centres plus each body's spin times its radius: the fastest any two
+  // points of the pair can approach (reach_ holds speed + spin x radius per body).
+  const float spinA = reach_[a] - bodies_.linearVelocity[a].norm(), spinB = reach_[b] - bodies_.linearVelocity[b].norm();
+  return (bodies_.linearVelocity[a] - bodies_.linearVelocity[b]).norm() + spinA + spinB;
+}
+
 bool World::canCollide(uint32_t a, uint32_t b) const {
   return bodies_.inverseMass[a] > 0.f || bodies_.inverseMass[b] > 0.f;
 }
@@ -16,6 +23,7 @@ void World::computeBounds() {
   const uint32_t n = bodies_.size();
   bounds_.resize(n);
   isStatic_.resize(n);
+  reach_.resize(n);
   for (uint32_t i = 0; i < n; ++i) {
     const RigidTransform pose = bodies_.shapePose(i);
     const Mat3f R = pose.rotation.toRotationMatrix().cwiseAbs();
@@ -35,8 +43,12 @@ void World::computeBounds() {
       centre = pose.translation;
       half = (R * bodies_.shape[i].primitive.localHalfExtents()).cast<double>();
     }
+    // How far any point of the body can move per second: its speed plus its spin times its
+    // radius about the centre of mass (a spinning capsule's ends outrun its centre).
+    const double radius = (centre - bodies_.position[i]).norm() + half.norm();
+    reach_[i] = float(double(bodies_.linearVelocity[i].norm()) + double(bodies_.angularVelocity[i].norm()) * radius);
     // A margin of how far the body can move this frame keeps fast bodies in their pairs.
-    const double margin = tuning::kBroadphaseMargin + double(bodies_.linearVelocity[i].norm()) * scene_.settings.timestep;
+    const double margin = tuning::kBroadphaseMargin + double(reach_[i]) * scene_.settings.timestep;
     bounds_[i] = {centre - half - Vec3d::Constant(margin), centre + half + Vec3d::Constant(margin)};
     isStatic_[i] = bodies_.motion[i] == MotionType::Static;
   }
@@ -84,7 +96,7 @@ void World::generateContacts(float dt) {
       // Speculative contacts: look as far ahead as the pair can close in one step, so fast
       // bodies meet thin plates before they pass them (the solver lets gaps close, not cross).
       ContactParams params = base;
-      params.speculativeMargin = tuning::kSpeculativeMargin + (bodies_.linearVelocity[a] - bodies_.linearVelocity[b]).norm() * dt;
+      params.speculativeMargin = tuning::kSpeculativeMargin + closingSpeed(a, b) * dt;
       const BodyShape& sa = bodies_.shape[a];
       const BodyShape& sb = bodies_.shape[b];
       if (sa.isGrid() && sb.isGrid()) {

@@ -35,7 +35,7 @@ void World::terrainPairs(float dt) {
     }
     std::vector<Contact>& out = pairContacts_[k];
     out.clear();
-    const float margin = tuning::kSpeculativeMargin + bodies_.linearVelocity[body].norm() * dt;
+    const float margin = tuning::kSpeculativeMargin + closingSpeed(body, terrainBody) * dt;
     terrainContacts(terrain, shape, pose, margin, out);
     pairFlipped_[k] = body == b;  // normals point from the terrain towards the body
     stats_.terrainContacts += uint32_t(out.size());

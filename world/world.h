@@ -122,6 +122,8 @@ class World {
   void generateContacts(float dt);
   void terrainPairs(float dt);
   bool canCollide(uint32_t a, uint32_t b) const;
+  /// The fastest the pair's surfaces can approach (m/s): relative speed plus both spins times radii.
+  float closingSpeed(uint32_t a, uint32_t b) const;
   bool active(uint32_t body) const {
     return bodies_.motion[body] == MotionType::Kinematic || (bodies_.motion[body] == MotionType::Dynamic && !sleep_.asleep(body));
   }
@@ -144,6 +146,7 @@ class World {
   BodyStore bodies_;
   std::vector<WorldAabb> bounds_;
   std::vector<uint8_t> isStatic_;
+  std::vector<float> reach_;  // per body: speed + spin x radius (m/s), from computeBounds()
   SweepAndPrune broadphase_;
   std::vector<BodyPair> pairs_;
   std::vector<std::vector<Contact>> pairContacts_;  // one slot per pair, reused across frames

@@ -190,7 +190,8 @@ size_t BrickGrid::collide(const RigidTransform& gridPose, const QueryShape& shap
   const LocalPose pose{gridPose.pointToLocal(shapePose.translation), gridPose.rotationToLocal(shapePose.rotation).normalized()};
   scratch.raw.clear();
   collideLocal(shape, pose, params, scratch.raw, stats);
-  const int n = reduceManifold(scratch.raw.data(), int(scratch.raw.size()), params.maxContacts);
+  const int kept = keepDeepestPerShapePart(scratch.raw.data(), int(scratch.raw.size()));
+  const int n = reduceManifold(scratch.raw.data(), kept, params.maxContacts);
   for (int i = 0; i < n; ++i) {
     const LocalContact& c = scratch.raw[i];
     out.push_back({gridPose.pointToWorld(c.position), gridPose.directionToWorld(c.normal), c.depth, c.feature, c.material});

@@ -4,6 +4,8 @@
 #include <BulletCollision/CollisionShapes/btConvexPointCloudShape.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
 #include <algorithm>
+#include <limits>
+#include <optional>
 #include <btBulletCollisionCommon.h>
 #include <string>
 #include <vector>
@@ -40,6 +42,68 @@ struct BrickPointCloud {
   }
 };
 
+// A brick far larger than the query shape, clipped to the region around the shape: GJK on the
+// whole brick works with support points hundreds of metres away and, in float, loses the
+// closest features (a box touching a 500 m ramp measured 6 mm away, along a wrong normal, or not
+// at all). The part of the brick inside `region` has the same closest features and penetration
+// as the whole brick for anything inside the region, and its vertices lie near the shape.
+// Vertices are relative to the region's centre, where the transforms are shifted too.
+struct ClippedBrickCloud {
+  btVector3 verts[kMaxBrickVertices];
+  btConvexPointCloudShape shape;
+  int count = 0;
+  // Returns false when the brick has too many faces to clip by plane triples (big cylinders:
+  // they keep the whole-brick path) or nothing of it lies in the region.
+  bool build(const Brick& b, const Aabb& region) {
+    BrickPlane canonical[kMaxBrickPlanes];
+    const int nb = canonicalBrickPlanes(b, canonical);
+    if (nb > 12) return false;
+    // Planes n . y <= d in coordinates y relative to the region's centre (double: the offsets
+    // subtract large numbers).
+    const Vec3d c = region.center().cast<double>();
+    const Vec3d h = region.halfExtent().cast<double>();
+    Vec3d n[18];
+    double d[18];
+    const Mat3d r = b.rotation.matrix().cast<double>();
+    for (int i = 0; i < nb; ++i) {
+      n[i] = r * canonical[i].n.cast<double>();
+      d[i] = double(canonical[i].d) + n[i].dot(b.position.cast<double>() - c);
+    }
+    int np = nb;
+    for (int a = 0; a < 3; ++a) {
+      n[np] = Vec3d::Unit(a);
+      d[np++] = h[a];
+      n[np] = -Vec3d::Unit(a);
+      d[np++] = h[a];
+    }
+    const double tolerance = 1e-6 * (1.0 + h.maxCoeff());
+    for (int i = 0; i < np; ++i)
+      for (int j = i + 1; j < np; ++j)
+        for (int k = j + 1; k < np; ++k) {
+          Mat3d m;
+          m << n[i].transpose(), n[j].transpose(), n[k].transpose();
+          const double det = m.determinant();
+          if (std::abs(det) < 1e-9) continue;
+          const Vec3d y = m.inverse() * Vec3d(d[i], d[j], d[k]);
+          bool inside = true;
+          for (int q = 0; q < np && inside; ++q) inside = n[q].dot(y) <= d[q] + tolerance;
+          if (!inside) continue;
+          const btVector3 v(float(y.x()), float(y.y()), float(y.z()));
+          bool duplicate = false;
+          for (int q = 0; q < count && !duplicate; ++q) duplicate = (verts[q] - v).length2() < float(tolerance * tolerance) * 4.f;
+          if (!duplicate && count < kMaxBrickVertices) verts[count++] = v;
+        }
+    if (count < 4) return false;
+    shape.setPoints(verts, count, false);
+    shape.setMargin(0);
+    shape.recalcLocalAabb();
+    return true;
+  }
+};
+
+// A brick is clipped when it is this many times larger than the query shape (with its margin).
+constexpr float kClipBrickRatio = 8.f;
+
 btTransform poseTransform(const LocalPose& p) {
   return btTransform(btQuaternion(p.rotation.x(), p.rotation.y(), p.rotation.z(), p.rotation.w()), bt(p.position));
 }
@@ -73,10 +137,13 @@ int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConve
     const float gap = float(res.distance) - margins;
     if (gap >= margin) return 0;
     const Vec3f n = fromBt(trShape.getBasis() * res.normal).normalized();
-    if (!n.allFinite()) return 0;
-    const Vec3f onBrick = fromBt(res.witnesses[1]) + n * float(brick.getMargin());
-    out[0] = {onBrick, n, -gap, feature, material};
-    return 1;
+    if (n.allFinite()) {
+      const Vec3f onBrick = fromBt(res.witnesses[1]) + n * float(brick.getMargin());
+      out[0] = {onBrick, n, -gap, feature, material};
+      return 1;
+    }
+    // note: cores exactly touching (a distance of 0) give GJK no direction; EPA below finds
+    // the contact. Returning nothing here let a box resting its corner on a face fall through.
   }
   if (!btGjkEpaSolver2::Penetration(&shape, trShape, &brick, trBrick, guess, res)) return 0;
   Vec3f n = fromBt(trShape.getBasis() * res.normal);
@@ -251,55 +318,157 @@ int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB,
   return n < kMaxContactsPerBrick ? addSpeculativeCorners(halfA, trA, halfB, trB, speculativeMargin, out, n) : n;
 }
 
+// GJK gives one point per pair. A capsule resting on its side needs both ends, and one that
+// falls tilted needs its far end held back as it swings down: each end of the core, as a
+// sphere of the capsule's radius, adds its own contact (with its own normal and gap) when it
+// is within the margin and not where a contact already is.
+int addCapsuleEnds(const QueryShape& capsule, const btTransform& trCapsule, const btConvexShape& brick, const btTransform& trBrick,
+                   float margin, LocalContact* out, int count) {
+  const btVector3 axis = trCapsule.getBasis().getColumn(2) * capsule.halfHeight;
+  btSphereShape end(capsule.radius);
+  const float slack = 1e-3f * (1.f + capsule.radius + capsule.halfHeight);
+  for (float sign : {-1.f, 1.f}) {
+    if (count >= kMaxContactsPerBrick) break;
+    btTransform trEnd(btMatrix3x3::getIdentity(), trCapsule.getOrigin() + axis * sign);
+    LocalContact c;
+    if (gjkEpa(end, trEnd, brick, trBrick, out[0].feature, out[0].material, margin, &c) == 0) continue;
+    if (std::any_of(out, out + count, [&](const LocalContact& o) { return (o.position - c.position).norm() < slack; })) continue;
+    c.shapePart = sign < 0.f ? 1 : 2;
+    out[count++] = c;
+  }
+  return count;
+}
+
+// The same for a box against a brick that is not a box (wedge, corner, cylinder), where Bullet's
+// box-box manifold does not apply. GJK/EPA gives the deepest point and its normal; the box's
+// corners are measured against that contact's plane, and those within the margin and no deeper
+// than it, whose projection onto the plane lies on the brick, get contacts of their own, lowest
+// first. So a box landing flat on a ramp is held at its corners, penetrating or not, and the
+// corners on the far side of the box (hidden behind the near ones) are never used.
+int addBoxCorners(const Vec3f& half, const btTransform& trBox, const Brick& brick, float margin, LocalContact* out, int count) {
+  const Vec3f n = out[0].normal, onBrick = out[0].position;
+  const float deepest = out[0].depth;
+  const float tolerance = 1e-3f * (1.f + half.maxCoeff());
+  // note: GJK's witness on a brick hundreds of metres long is off by ~1e-5 of its size, so a
+  // corner may measure slightly deeper than the "deepest" point.
+  const float depthSlack = tolerance + 2e-5f * brick.halfSize.maxCoeff();
+  LocalContact corners[8];
+  int found = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3f local((i & 1) ? half.x() : -half.x(), (i & 2) ? half.y() : -half.y(), (i & 4) ? half.z() : -half.z());
+    const Vec3f v = fromBt(trBox * bt(local));
+    const float gap = (v - onBrick).dot(n);
+    if (gap >= margin || gap < -(deepest + depthSlack)) continue;
+    const Vec3f onFace = v - n * gap;
+    if (!brickContains(brick, onFace, tolerance)) continue;
+    if (std::any_of(out, out + count, [&](const LocalContact& o) { return (o.position - onFace).norm() < tolerance; })) continue;
+    corners[found++] = {onFace, n, -gap, out[0].feature, out[0].material, uint8_t(1 + i)};
+  }
+  std::sort(corners, corners + found, [](const LocalContact& x, const LocalContact& y) { return x.depth > y.depth; });
+  for (int i = 0; i < found && count < kMaxContactsPerBrick; ++i) out[count++] = corners[i];
+  return count;
+}
+
 }  // namespace
 
 int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature,
                       float speculativeMargin, LocalContact* out) {
   const btTransform trShape = poseTransform(pose);
   const btTransform trBrick = brickTransform(b);
-  if (shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box)
+  const float reach = shape.localHalfExtents().norm() + std::max(speculativeMargin, 0.f);
+  const bool huge = b.halfSize.maxCoeff() > kClipBrickRatio * reach;
+  if (!huge && shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box)
     return collideBoxes(shape.halfExtents, trShape, b.halfSize, trBrick, feature, b.material, speculativeMargin, out);
-  BrickPointCloud cloud(b);
-  return withBulletShape(shape, [&](btConvexShape& s) {
-    return gjkEpa(s, trShape, cloud.shape, trBrick, feature, b.material, speculativeMargin, out);
+  // The brick as a Bullet shape: whole, or (huge) its part around the shape in coordinates
+  // centred there, with the shape's transform shifted to match.
+  ClippedBrickCloud clipped;
+  const Aabb region = Aabb::fromCenterHalf(pose.position, Vec3f::Constant(2.f * reach));
+  const bool clip = huge && clipped.build(b, region);
+  std::optional<BrickPointCloud> whole;
+  if (!clip) whole.emplace(b);
+  const btConvexShape& brickShape = clip ? static_cast<const btConvexShape&>(clipped.shape) : whole->shape;
+  const btVector3 offset = clip ? bt(region.center()) : btVector3(0, 0, 0);
+  const btTransform trS(trShape.getBasis(), trShape.getOrigin() - offset);
+  const btTransform trB = clip ? btTransform::getIdentity() : trBrick;
+  int n = withBulletShape(shape, [&](btConvexShape& s) {
+    return gjkEpa(s, trS, brickShape, trB, feature, b.material, speculativeMargin, out);
   });
+  if (n == 0) return 0;
+  if (shape.kind == QueryShape::Kind::Capsule) n = addCapsuleEnds(shape, trS, brickShape, trB, speculativeMargin, out, n);
+  for (int i = 0; i < n; ++i) out[i].position += fromBt(offset);
+  if (shape.kind == QueryShape::Kind::Box) return addBoxCorners(shape.halfExtents, trShape, b, speculativeMargin, out, n);
+  return n;
+}
+
+int keepDeepestPerShapePart(LocalContact* c, int n) {
+  float deepest[256];
+  bool seen[256] = {};
+  for (int i = 0; i < n; ++i) {
+    const uint8_t p = c[i].shapePart;
+    if (p == 0) continue;
+    if (!seen[p] || c[i].depth > deepest[p]) deepest[p] = c[i].depth;
+    seen[p] = true;
+  }
+  int w = 0;
+  for (int i = 0; i < n; ++i) {
+    const uint8_t p = c[i].shapePart;
+    if (p != 0) {
+      if (c[i].depth != deepest[p]) continue;
+      deepest[p] = std::numeric_limits<float>::infinity();  // the first of equal depths only
+    }
+    c[w++] = c[i];
+  }
+  return w;
 }
 
 int reduceManifold(LocalContact* c, int n, int maxOut) {
   if (n <= maxOut) return n;
-  // 1. deepest; 2. farthest from it; 3. largest triangle; 4. largest area added (quad).
-  auto swapTo = [&](int dst, int src) { std::swap(c[dst], c[src]); };
-  int best = 0;
-  for (int i = 1; i < n; ++i)
-    if (c[i].depth > c[best].depth) best = i;
-  swapTo(0, best);
-  int kept = 1;
-  while (kept < maxOut) {
-    int pick = -1;
-    float score = -1.f;
-    for (int i = kept; i < n; ++i) {
-      float s;
-      if (kept == 1) {
-        s = (c[i].position - c[0].position).squaredNorm();
-      } else if (kept == 2) {
-        s = (c[1].position - c[0].position).cross(c[i].position - c[0].position).squaredNorm();
-      } else {
-        // distance to the triangle's plane area proxy: sum of areas with each kept edge
-        s = 0.f;
-        for (int a = 0; a < kept; ++a) {
-          const int bIdx = (a + 1) % kept;
-          s = std::max(s, (c[bIdx].position - c[a].position).cross(c[i].position - c[a].position).squaredNorm());
+  // Contacts are grouped by normal direction (floor, wall, a neighbouring brick's edge ...) and
+  // each group is reduced on its own to maxOut points, so a box falling beside a wall keeps
+  // its floor contacts however near the wall is; at most kMaxNormalGroups groups, deepest first.
+  // Within a group depth decides before distance: the deepest point, then points at least
+  // `spacing` (a fifth of the group's spread) from every point kept, deepest first, then the
+  // deepest of the rest. (A purely geometric choice, farthest point and largest area, kept
+  // far-away speculative contacts with large gaps instead of the one holding back the shape's
+  // other end.)
+  constexpr float kSameDirection = 0.9f;  // cos of ~25 degrees
+  constexpr int kMaxNormalGroups = 4;
+  std::stable_sort(c, c + n, [](const LocalContact& x, const LocalContact& y) { return x.depth > y.depth; });
+  thread_local std::vector<int8_t> group;  // per contact: its normal group, -1 none (dropped)
+  thread_local std::vector<uint8_t> used;
+  thread_local std::vector<LocalContact> kept;
+  group.assign(size_t(n), -1);
+  used.assign(size_t(n), 0);
+  kept.clear();
+  Vec3f groupNormal[kMaxNormalGroups];
+  int groups = 0;
+  for (int i = 0; i < n; ++i) {
+    for (int g = 0; g < groups && group[size_t(i)] < 0; ++g)
+      if (groupNormal[g].dot(c[i].normal) > kSameDirection) group[size_t(i)] = int8_t(g);
+    if (group[size_t(i)] < 0 && groups < kMaxNormalGroups) {
+      groupNormal[groups] = c[i].normal;
+      group[size_t(i)] = int8_t(groups++);
+    }
+  }
+  for (int g = 0; g < groups; ++g) {
+    Aabb spread = Aabb::empty();
+    for (int i = 0; i < n; ++i)
+      if (group[size_t(i)] == g) spread.merge(Aabb{c[i].position, c[i].position});
+    const float spacing = 0.2f * (spread.max - spread.min).norm();
+    const size_t first = kept.size();
+    for (int pass = 0; pass < 2; ++pass)
+      for (int i = 0; i < n && int(kept.size() - first) < maxOut; ++i) {
+        if (group[size_t(i)] != g || used[size_t(i)]) continue;
+        const bool apart = std::none_of(kept.begin() + long(first), kept.end(),
+                                        [&](const LocalContact& k) { return (k.position - c[i].position).norm() < spacing; });
+        if (pass == 1 || apart) {
+          kept.push_back(c[i]);
+          used[size_t(i)] = 1;
         }
       }
-      if (s > score) {
-        score = s;
-        pick = i;
-      }
-    }
-    if (pick < 0) break;
-    swapTo(kept++, pick);
   }
-  return kept;
+  std::copy(kept.begin(), kept.end(), c);
+  return int(kept.size());
 }
 
 }  // namespace bw

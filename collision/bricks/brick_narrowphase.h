@@ -21,6 +21,10 @@ struct LocalContact {
   float depth;       ///< > 0 penetration, < 0 speculative gap
   uint32_t feature;  ///< brick id (or LOD subtree tag)
   uint32_t material;
+  /// The part of the query shape the contact holds back: 0 the shape as a whole (GJK/EPA's
+  /// deepest point, a box-box manifold point), 1 and 2 a capsule's ends, 1..8 a box's corners.
+  /// Across bricks, only the deepest contact of each part 1.. is worth keeping.
+  uint8_t shapePart = 0;
 };
 
 /// Pose of a query shape in the grid frame.
@@ -52,6 +56,10 @@ bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f
 
 /// Reduces n contacts to at most maxOut in place (deepest first, then the points that span the
 /// largest area). Returns the new count. Deterministic for a given input order.
+/// Keeps, for each shape part above 0, only its deepest contact (the one that holds the part
+/// back first); contacts of part 0 all stay. Compacts c[0, n) in order; returns the new count.
+int keepDeepestPerShapePart(LocalContact* c, int n);
+
 int reduceManifold(LocalContact* contacts, int n, int maxOut);
 
 }  // namespace bw
