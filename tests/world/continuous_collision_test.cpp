@@ -3,7 +3,9 @@
 // step gets contacts out to that gap, and the solver lets the gap close but not cross. These
 // tests fire bodies far faster than their size per step at thin targets, from seeded random
 // positions, orientations and directions, and demand that every run stays on the near side.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <gtest/gtest.h>
 #include <string>
 
@@ -14,6 +16,18 @@
 namespace bw {
 namespace {
 
+// How far below the target's face the body's lowest point may go (m), as measured (release, the
+// seeds below; the tests print the deepest value):
+// - sphere: its lowest point never goes measurably below the wall's face (-0.0000): the
+//   solver's resting overlap kSlop (5 mm) is asserted.
+// - box: its lowest corner reaches 0.096 m below the plate's top (dt 1/60 and 1/120; 60 of the
+//   120 runs go deeper than 2 cm): the speculative contact stops the box at the plate, but the
+//   impact turns it and a corner swings into the plate within the step. It never passes the
+//   0.2 m plate; 0.1 m (half the plate) is asserted. FINDING for the world owner: a 2 cm bound
+//   (the intent "never passes the plate" with speculative-contact slop) fails today.
+constexpr double kBoxSlop = 0.1;
+constexpr double kSphereSlop = 0.005;
+
 struct Shot {
   SpawnerDescription::Shape shape;
   float size;        // box half extent or sphere radius
@@ -21,8 +35,21 @@ struct Shot {
   double timestep;
 };
 
+// The lowest z of the body's collision shape: a box's lowest corner (in whatever orientation it
+// turned to), a sphere's centre minus its radius.
+double lowestPoint(const BodyStore& bodies, uint32_t body) {
+  const RigidTransform pose = bodies.shapePose(body);
+  const QueryShape& shape = bodies.shape[body].primitive;
+  if (shape.kind == QueryShape::Kind::Sphere) return pose.translation.z() - shape.radius;
+  const Mat3f R = pose.rotation.toRotationMatrix();
+  double below = 0;
+  for (int j = 0; j < 3; ++j) below += std::abs(R(2, j)) * shape.halfExtents[j];
+  return pose.translation.z() - below;
+}
+
 // A static target whose top face is z = 0; the body starts `start` above it, aimed down with a
-// seeded sideways tilt. Returns the lowest z the body's centre reached.
+// seeded sideways tilt. Returns the lowest z any point of the body reached (lowestPoint, after
+// every frame).
 double fire(const SceneDescription& target, const Shot& shot, uint64_t seed, double start, int frames) {
   SceneDescription scene = target;
   SeededRandom r(seed);
@@ -43,10 +70,10 @@ double fire(const SceneDescription& target, const Shot& shot, uint64_t seed, dou
   scene.spawners = {s};
   World world(scene, 1);
   const uint32_t body = world.bodies().size() - 1;
-  double lowest = world.bodies().position[body].z();
+  double lowest = lowestPoint(world.bodies(), body);
   for (int f = 0; f < frames; ++f) {
     world.step();
-    lowest = std::min(lowest, world.bodies().position[body].z());
+    lowest = std::min(lowest, lowestPoint(world.bodies(), body));
   }
   return lowest;
 }
@@ -55,18 +82,19 @@ TEST(ContinuousCollision, HalfMetreBoxAt100MetresPerSecondNeverPassesA02Plate) {
   // One 0.2-thick plate, 20 x 20, top face at z = 0.
   const SceneDescription plate = parseScene(R"({"name": "plate",
       "grids": [{"name": "plate", "bricks": [{"position": [0, 0, -0.1], "half_size": [10, 10, 0.1]}]}]})", "plate.json");
-  int runs = 0;
+  double worst = 1e9;
   for (double timestep : {1.0 / 30, 1.0 / 60, 1.0 / 120})
     for (uint64_t seed = 1; seed <= 40; ++seed) {
       const Shot shot{SpawnerDescription::Shape::Box, 0.25f, 100.0, timestep};
       // Starts 1.5 steps of travel above the plate: it reaches the plate mid-step.
       const double lowest = fire(plate, shot, seed, 1.5 * 100.0 * timestep, 30);
-      // A box's centre stays at least its half extent above the top face minus the slop, in any
-      // orientation that still has it in front of the plate (far above -0.2, the plate's bottom).
-      EXPECT_GT(lowest, 0.0) << "seed " << seed << ", dt " << timestep << ": the box's centre went below the plate's top";
-      ++runs;
+      worst = std::min(worst, lowest);
+      // No point of the box (its lowest corner, in whatever orientation the impact turned it
+      // to) goes further below the plate's top than the solver's allowed overlap kBoxSlop.
+      EXPECT_GE(lowest, -kBoxSlop) << "seed " << seed << ", dt " << timestep << ": the box's lowest corner reached "
+                                   << lowest << ", below the plate's top (z = 0) by more than the slop";
     }
-  EXPECT_EQ(runs, 120);
+  std::printf("[ box      ] deepest corner over every run: %.4f m (slop %.3f)\n", worst, kBoxSlop);
 }
 
 TEST(ContinuousCollision, TenCentimetreSphereAt300MetresPerSecondNeverPassesAMicrobrickWall) {
@@ -78,12 +106,17 @@ TEST(ContinuousCollision, TenCentimetreSphereAt300MetresPerSecondNeverPassesAMic
                 std::to_string(-1.96 + 0.08 * j) + ", -0.04], \"half_size\": [0.04, 0.04, 0.04]}";
   const SceneDescription wall = parseScene("{\"name\": \"wall\", \"grids\": [{\"name\": \"wall\", \"bricks\": [" + bricks + "]}]}",
                                            "wall.json");
+  double worst = 1e9;
   for (double timestep : {1.0 / 60, 1.0 / 120})
     for (uint64_t seed = 1; seed <= 30; ++seed) {
       const Shot shot{SpawnerDescription::Shape::Sphere, 0.05f, 300.0, timestep};
       const double lowest = fire(wall, shot, seed, 1.5 * 300.0 * timestep, 20);
-      EXPECT_GT(lowest, 0.0) << "seed " << seed << ", dt " << timestep << ": the sphere's centre went below the wall's face";
+      worst = std::min(worst, lowest);
+      // The sphere's centre stays at least its radius minus kSphereSlop above the wall's face.
+      EXPECT_GE(lowest, -kSphereSlop) << "seed " << seed << ", dt " << timestep << ": the sphere's lowest point reached "
+                                      << lowest << ", below the wall's face (z = 0) by more than the slop";
     }
+  std::printf("[ sphere   ] deepest point over every run: %.4f m (slop %.3f)\n", worst, kSphereSlop);
 }
 
 }  // namespace

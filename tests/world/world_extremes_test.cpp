@@ -464,7 +464,6 @@ INSTANTIATE_TEST_SUITE_P(FromOneThousandthToOneFifteenth, WorldTimestep, ::testi
 // pass the plate: its centre stays above the plate's top face minus the 5 mm slop and its radius;
 // after 2 s it lies on the plate (rolling, as a sphere without rolling resistance does).
 TEST(WorldExtremes, MillimetreSphereLandsOnAPlateWithoutTunnelling) {
-  int runs = 0;
   for (uint64_t seed = 1; seed <= 8; ++seed) {
     const double x = -0.3 + 0.07 * double(seed), y = 0.2 - 0.05 * double(seed);
     const SceneDescription s = parseScene(R"({"name": "tiny", "settings": {"sleeping": false},
@@ -493,9 +492,7 @@ TEST(WorldExtremes, MillimetreSphereLandsOnAPlateWithoutTunnelling) {
     const Vec3f v = w.bodies().linearVelocity[1];
     EXPECT_LT(std::abs(v.z()), 0.01f) << "seed " << seed;
     EXPECT_NEAR(std::hypot(v.x(), v.y()), 5.0 / 7.0 * std::hypot(0.3, 0.2), 0.03) << "seed " << seed;
-    ++runs;
   }
-  EXPECT_EQ(runs, 8);
 }
 
 // A giant box (half extent `half`, density 1) floating at rest without gravity, and a dynamic

@@ -23,7 +23,7 @@
 #include "collision/content/build_tiling.h"
 #include "collision/core/argument_checks.h"
 #include "collision/core/seeded_random.h"
-#include "brute_force_index.h"
+#include "collision/support/brute_force_index.h"
 
 namespace bw {
 namespace {
@@ -33,7 +33,7 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // The shared data folder is a sibling of the repository: <repo>/../shared/data.
 std::filesystem::path lighthousePath() {
   namespace fs = std::filesystem;
-  const fs::path repo = fs::path(__FILE__).parent_path().parent_path().parent_path();
+  const fs::path repo = fs::path(__FILE__).parent_path().parent_path().parent_path().parent_path();
   const fs::path candidate = repo / ".." / "shared" / "data" / "Lighthouse_Island.brs";
   if (fs::exists(candidate)) return candidate;
   const fs::path fromCwd = fs::current_path() / ".." / "shared" / "data" / "Lighthouse_Island.brs";

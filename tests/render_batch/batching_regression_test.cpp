@@ -203,14 +203,30 @@ TEST(BatchOverflow, IsReportedAndLeavesTheSceneAtTheLastGoodFrame) {
   EXPECT_TRUE(pipeline.renderThread().scene().identicalTo(untouched));
 }
 
+// Batches of exactly the store's primitive and light counts, with every body moving (so every
+// primitive is appended every frame): no overflow, and the render scene after each frame is
+// byte-identical to a serial reference run of the same workload (a batch one short would throw,
+// IsReportedAndLeavesTheSceneAtTheLastGoodFrame; one that silently dropped or duplicated a record
+// would differ here).
 TEST(BatchOverflow, ExactCapacityIsEnough) {
   AttachmentWorkload w = makeAttachmentWorkload({.attachments = 2000, .seed = 9});
-  RenderFramePipeline pipeline(w.store, SubmissionMode::Batched);
+  AttachmentWorkload refWorkload = makeAttachmentWorkload({.attachments = 2000, .seed = 9});
+  RenderScene refScene(refWorkload.store.primitiveCount(), refWorkload.store.lightAttenuationRadii());
+  const uint64_t initialHash = refScene.stateHash();
+  RenderFramePipeline pipeline(w.store, SubmissionMode::Batched, {}, w.store.primitiveCount(), w.store.lightCount());
   for (uint64_t frame = 1; frame <= 3; ++frame) {
     w.bodies.step(frame, 1.f);
+    refWorkload.bodies.step(frame, 1.f);
+    DirectApply sink(refScene);
+    TransformUpdate(refWorkload.store, refWorkload.bodies.view(), sink).runSerial();
+    EXPECT_EQ(sink.primitives, w.store.primitiveCount()) << "frame " << frame << ": not every primitive moved";
     EXPECT_NO_THROW(pipeline.runFrame(w.bodies.view(), [](TransformUpdate& u) { test::runOnThreadTeam(u, 2); }));
+    pipeline.renderThread().waitForFrame(frame);
+    EXPECT_EQ(pipeline.renderThread().scene().stateHash(), refScene.stateHash()) << "frame " << frame;
   }
   pipeline.finish();
+  EXPECT_NE(refScene.stateHash(), initialHash) << "the reference never moved";
+  EXPECT_TRUE(pipeline.renderThread().scene().identicalTo(refScene));
 }
 
 TEST(RenderThread, ErrorOnTheRenderThreadReachesTheGame) {

@@ -10,7 +10,7 @@
 #include "collision/core/seeded_random.h"
 #include "collision/index/loose_octree.h"
 #include "collision/index/octobvh.h"
-#include "brute_force_index.h"
+#include "collision/support/brute_force_index.h"
 
 namespace bw {
 namespace {

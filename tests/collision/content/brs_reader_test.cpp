@@ -24,7 +24,7 @@ namespace {
 // The shared data folder is a sibling of the repository: <repo>/../shared/data.
 std::filesystem::path lighthousePath() {
   namespace fs = std::filesystem;
-  const fs::path repo = fs::path(__FILE__).parent_path().parent_path().parent_path();
+  const fs::path repo = fs::path(__FILE__).parent_path().parent_path().parent_path().parent_path();
   const fs::path candidate = repo / ".." / "shared" / "data" / "Lighthouse_Island.brs";
   if (fs::exists(candidate)) return candidate;
   for (fs::path dir = fs::current_path(); !dir.empty(); dir = dir.parent_path()) {
