@@ -133,7 +133,8 @@ int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConve
   btGjkEpaSolver2::sResults res;
   const btVector3 guess = trShape.getOrigin() - trBrick.getOrigin();
   const float margins = float(shape.getMargin() + brick.getMargin());
-  if (btGjkEpaSolver2::Distance(&shape, trShape, &brick, trBrick, guess, res)) {
+  const bool separated = btGjkEpaSolver2::Distance(&shape, trShape, &brick, trBrick, guess, res);
+  if (separated) {
     const float gap = float(res.distance) - margins;
     if (gap >= margin) return 0;
     const Vec3f n = fromBt(trShape.getBasis() * res.normal).normalized();
@@ -142,14 +143,53 @@ int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConve
       out[0] = {onBrick, n, -gap, feature, material};
       return 1;
     }
-    // note: cores exactly touching (a distance of 0) give GJK no direction; EPA below finds
-    // the contact. Returning nothing here let a box resting its corner on a face fall through.
+    // note: cores exactly touching (a distance of 0) give GJK no direction, and EPA (which
+    // needs overlapping cores) is no use either: the lifted measurement below finds it.
+    if (margins > 0.f) return 0;
   }
-  if (!btGjkEpaSolver2::Penetration(&shape, trShape, &brick, trBrick, guess, res)) return 0;
-  Vec3f n = fromBt(trShape.getBasis() * res.normal);
-  if (!n.allFinite() || n.squaredNorm() < 1e-12f) return 0;
-  out[0] = {fromBt(res.witnesses[1]), n.normalized(), -float(res.distance), feature, material};
-  return 1;
+  if (!separated && btGjkEpaSolver2::Penetration(&shape, trShape, &brick, trBrick, guess, res)) {
+    const Vec3f n = fromBt(trShape.getBasis() * res.normal);
+    if (n.allFinite() && n.squaredNorm() > 1e-12f) {
+      out[0] = {fromBt(res.witnesses[1]), n.normalized(), -float(res.distance), feature, material};
+      return 1;
+    }
+  }
+  // Touching (GJK without a direction) or overlapping a thin brick where EPA finds no
+  // polytope: measured again with the shape lifted off the brick, the lift taken back out of
+  // the gap along the normal found (exact for a face contact). Touching needs only a tiny lift
+  // away from the brick's centre; an overlap needs a lift by the shape's own size, tried along
+  // that direction and the six axes (box bricks' face normals), the least overlap winning as
+  // in a separating-axis test. (Returning nothing here let a box that had just landed on a
+  // plate fall through it in the next step.)
+  // note: only for shapes without a margin (boxes, hulls): a sphere's or capsule's core
+  // touching the brick means the shape overlaps it by its radius, and a lifted measurement
+  // there found sideways normals on micro bricks that let a fast sphere through a wall.
+  if (margins > 0.f) return 0;
+  btVector3 lo, hi, shapeLo, shapeHi;
+  brick.getAabb(trBrick, lo, hi);
+  shape.getAabb(trShape, shapeLo, shapeHi);
+  const btScalar size = (shapeHi - shapeLo).length();
+  const btScalar lift = separated ? 1e-3f * (1.f + size) : size + 1e-3f;
+  btVector3 candidates[7] = {trShape.getOrigin() - (lo + hi) * 0.5f, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  bool found = false;
+  float bestGap = -std::numeric_limits<float>::infinity();
+  for (int k = 0; k < (separated ? 1 : 7); ++k) {
+    btVector3 away = candidates[k];
+    if (away.length2() < 1e-12f) away = btVector3(0, 0, 1);
+    away.normalize();
+    btTransform lifted = trShape;
+    lifted.setOrigin(trShape.getOrigin() + away * lift);
+    btGjkEpaSolver2::sResults r;
+    if (!btGjkEpaSolver2::Distance(&shape, lifted, &brick, trBrick, guess, r)) continue;
+    const Vec3f n = fromBt(lifted.getBasis() * r.normal).normalized();
+    if (!n.allFinite()) continue;
+    const float gap = float(r.distance) - margins - float(lift) * n.dot(fromBt(away));
+    if (found && gap <= bestGap) continue;
+    found = true;
+    bestGap = gap;
+    out[0] = {fromBt(r.witnesses[1]) + n * float(brick.getMargin()), n, -gap, feature, material};
+  }
+  return found && bestGap < margin ? 1 : 0;
 }
 
 }  // namespace
@@ -421,54 +461,90 @@ int keepDeepestPerShapePart(LocalContact* c, int n) {
   return w;
 }
 
-int reduceManifold(LocalContact* c, int n, int maxOut) {
+namespace {
+
+// Reduces c[0, n) to at most maxOut points in place: the deepest, the farthest from it, the one
+// making the largest triangle, then the one adding the largest area. Returns the count.
+int reduceByArea(LocalContact* c, int n, int maxOut) {
   if (n <= maxOut) return n;
-  // Contacts are grouped by normal direction (floor, wall, a neighbouring brick's edge ...) and
-  // each group is reduced on its own to maxOut points, so a box falling beside a wall keeps
-  // its floor contacts however near the wall is; at most kMaxNormalGroups groups, deepest first.
-  // Within a group depth decides before distance: the deepest point, then points at least
-  // `spacing` (a fifth of the group's spread) from every point kept, deepest first, then the
-  // deepest of the rest. (A purely geometric choice, farthest point and largest area, kept
-  // far-away speculative contacts with large gaps instead of the one holding back the shape's
-  // other end.)
-  constexpr float kSameDirection = 0.9f;  // cos of ~25 degrees
-  constexpr int kMaxNormalGroups = 4;
-  std::stable_sort(c, c + n, [](const LocalContact& x, const LocalContact& y) { return x.depth > y.depth; });
-  thread_local std::vector<int8_t> group;  // per contact: its normal group, -1 none (dropped)
-  thread_local std::vector<uint8_t> used;
-  thread_local std::vector<LocalContact> kept;
-  group.assign(size_t(n), -1);
-  used.assign(size_t(n), 0);
-  kept.clear();
-  Vec3f groupNormal[kMaxNormalGroups];
-  int groups = 0;
-  for (int i = 0; i < n; ++i) {
-    for (int g = 0; g < groups && group[size_t(i)] < 0; ++g)
-      if (groupNormal[g].dot(c[i].normal) > kSameDirection) group[size_t(i)] = int8_t(g);
-    if (group[size_t(i)] < 0 && groups < kMaxNormalGroups) {
-      groupNormal[groups] = c[i].normal;
-      group[size_t(i)] = int8_t(groups++);
-    }
-  }
-  for (int g = 0; g < groups; ++g) {
-    Aabb spread = Aabb::empty();
-    for (int i = 0; i < n; ++i)
-      if (group[size_t(i)] == g) spread.merge(Aabb{c[i].position, c[i].position});
-    const float spacing = 0.2f * (spread.max - spread.min).norm();
-    const size_t first = kept.size();
-    for (int pass = 0; pass < 2; ++pass)
-      for (int i = 0; i < n && int(kept.size() - first) < maxOut; ++i) {
-        if (group[size_t(i)] != g || used[size_t(i)]) continue;
-        const bool apart = std::none_of(kept.begin() + long(first), kept.end(),
-                                        [&](const LocalContact& k) { return (k.position - c[i].position).norm() < spacing; });
-        if (pass == 1 || apart) {
-          kept.push_back(c[i]);
-          used[size_t(i)] = 1;
+  int best = 0;
+  for (int i = 1; i < n; ++i)
+    if (c[i].depth > c[best].depth) best = i;
+  std::swap(c[0], c[best]);
+  int kept = 1;
+  while (kept < maxOut) {
+    int pick = -1;
+    float score = -1.f;
+    for (int i = kept; i < n; ++i) {
+      float s;
+      if (kept == 1) {
+        s = (c[i].position - c[0].position).squaredNorm();
+      } else if (kept == 2) {
+        s = (c[1].position - c[0].position).cross(c[i].position - c[0].position).squaredNorm();
+      } else {
+        // distance to the triangle's plane area proxy: sum of areas with each kept edge
+        s = 0.f;
+        for (int a = 0; a < kept; ++a) {
+          const int bIdx = (a + 1) % kept;
+          s = std::max(s, (c[bIdx].position - c[a].position).cross(c[i].position - c[a].position).squaredNorm());
         }
       }
+      if (s > score) {
+        score = s;
+        pick = i;
+      }
+    }
+    if (pick < 0) break;
+    std::swap(c[kept++], c[pick]);
   }
-  std::copy(kept.begin(), kept.end(), c);
-  return int(kept.size());
+  return kept;
+}
+
+}  // namespace
+
+int reduceManifold(LocalContact* c, int n, int maxOut) {
+  if (n <= maxOut) return n;
+  // Contacts are grouped by normal direction (the floor, a wall, a neighbouring brick's edge)
+  // in order of each group's deepest contact, and each group is reduced on its own (deepest,
+  // farthest, largest triangle, largest area). Reduced together, a shape over many bricks lost
+  // the contacts that mattered: a box falling beside a wall kept only wall contacts, and a
+  // capsule landing across bricks kept far-away contacts on neighbouring brick edges instead of
+  // the one under its other end. At most kManifoldNormalGroups groups: a contact of yet another
+  // direction joins the group of the nearest one.
+  constexpr float kSameDirection = 0.9f;  // cos of ~25 degrees
+  thread_local std::vector<LocalContact> sorted;
+  thread_local std::vector<int8_t> group;
+  sorted.assign(c, c + n);
+  group.assign(size_t(n), -1);
+  // Groups in order of their deepest contact: visit contacts deepest first (ties by index).
+  thread_local std::vector<int> order;
+  order.resize(size_t(n));
+  for (int i = 0; i < n; ++i) order[size_t(i)] = i;
+  std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return sorted[size_t(x)].depth > sorted[size_t(y)].depth; });
+  Vec3f groupNormal[kManifoldNormalGroups];
+  int groups = 0;
+  for (int i : order) {
+    for (int g = 0; g < groups && group[size_t(i)] < 0; ++g)
+      if (groupNormal[g].dot(sorted[size_t(i)].normal) > kSameDirection) group[size_t(i)] = int8_t(g);
+    if (group[size_t(i)] < 0 && groups < kManifoldNormalGroups) {
+      groupNormal[groups] = sorted[size_t(i)].normal;
+      group[size_t(i)] = int8_t(groups++);
+    }
+    if (group[size_t(i)] < 0) {  // more directions than groups: the nearest direction's group
+      int nearest = 0;
+      for (int g = 1; g < groups; ++g)
+        if (groupNormal[g].dot(sorted[size_t(i)].normal) > groupNormal[nearest].dot(sorted[size_t(i)].normal)) nearest = g;
+      group[size_t(i)] = int8_t(nearest);
+    }
+  }
+  int out = 0;
+  for (int g = 0; g < groups; ++g) {
+    const int first = out;
+    for (int i = 0; i < n; ++i)
+      if (group[size_t(i)] == g) c[out++] = sorted[size_t(i)];
+    out = first + reduceByArea(c + first, out - first, maxOut);
+  }
+  return out;
 }
 
 }  // namespace bw

@@ -54,12 +54,19 @@ int collideShapes(const QueryShape& a, const LocalPose& poseA, const QueryShape&
 bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f& from, const Vec3f& to, const Brick& b,
                      float& fraction, Vec3f& normal, Vec3f& point);
 
-/// Reduces n contacts to at most maxOut in place (deepest first, then the points that span the
-/// largest area). Returns the new count. Deterministic for a given input order.
 /// Keeps, for each shape part above 0, only its deepest contact (the one that holds the part
 /// back first); contacts of part 0 all stay. Compacts c[0, n) in order; returns the new count.
 int keepDeepestPerShapePart(LocalContact* c, int n);
 
+/// Most normal directions a reduced manifold keeps (a floor, a wall, ...).
+constexpr int kManifoldNormalGroups = 4;
+
+/// Reduces n contacts in place: grouped by normal direction (within ~25 degrees, at most
+/// kManifoldNormalGroups groups in order of their deepest contact; further directions join the
+/// nearest group), each group to at most maxOut points (its deepest, the farthest from it, the
+/// largest triangle, the largest area added). The kept contacts come first, group by group;
+/// returns their count (at most maxOut x kManifoldNormalGroups). Deterministic for a given input
+/// order. n <= maxOut: nothing changes.
 int reduceManifold(LocalContact* contacts, int n, int maxOut);
 
 }  // namespace bw

@@ -150,3 +150,30 @@ TEST(ManifoldReduction, IsAPureFunctionOfItsInput) {
 
 }  // namespace
 }  // namespace bw
+
+namespace bw {
+namespace {
+
+// A box falling beside a wall: four wall contacts nearer (smaller gaps) than the floor's. The
+// reduction keeps each direction's own manifold, so the floor is held however near the wall is
+// (reduced together, the four slots went to the wall and the box fell through the floor).
+TEST(ManifoldReduction, EachNormalDirectionKeepsItsOwnContacts) {
+  std::vector<LocalContact> c;
+  for (int i = 0; i < 6; ++i)  // wall x = 0, normal +x, gaps 0.05..0.10
+    c.push_back({Vec3f(0.f, 0.1f * float(i), 0.3f), Vec3f::UnitX(), -0.05f - 0.01f * float(i), uint32_t(i), 0});
+  for (int i = 0; i < 6; ++i)  // floor z = 0, normal +z, gaps 0.40..0.45
+    c.push_back({Vec3f(0.2f + 0.1f * float(i % 3), 0.1f * float(i / 3), 0.f), Vec3f::UnitZ(), -0.40f - 0.01f * float(i), uint32_t(10 + i), 0});
+  // A contact of a third direction (a neighbouring brick's edge) forms a group of its own.
+  c.push_back({Vec3f(0.5f, 0.5f, 0.f), Vec3f(0.f, 0.6f, 0.8f).normalized(), -0.5f, 20u, 0});
+  const int kept = reduceManifold(c.data(), int(c.size()), 4);
+  int wall = 0, floor = 0;
+  for (int i = 0; i < kept; ++i) (c[size_t(i)].normal.x() > 0.9f ? wall : floor)++;
+  EXPECT_EQ(wall, 4);
+  EXPECT_GE(floor, 1);
+  EXPECT_LE(kept, 4 * kManifoldNormalGroups);
+  // The deepest contact of all comes first.
+  EXPECT_EQ(c[0].feature, 0u);
+}
+
+}  // namespace
+}  // namespace bw
