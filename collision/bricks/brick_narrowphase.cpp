@@ -417,6 +417,18 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
   const btTransform trBrick = brickTransform(b);
   const float reach = shape.localHalfExtents().norm() + std::max(speculativeMargin, 0.f);
   const bool huge = b.halfSize.maxCoeff() > kClipBrickRatio * reach;
+  if (huge && b.shape == BrickShape::Box) {
+    // A huge box brick is axis-aligned in the grid frame (rotations are signed permutations):
+    // its part around the shape is the overlap of two boxes, itself a box near the shape.
+    const Aabb whole = brickBounds(b), region = Aabb::fromCenterHalf(pose.position, Vec3f::Constant(2.f * reach));
+    const Aabb part{whole.min.cwiseMax(region.min), whole.max.cwiseMin(region.max)};
+    if (part.isEmpty()) return 0;
+    Brick near = b;
+    near.position = part.center();
+    near.halfSize = part.halfExtent().cwiseMax(Vec3f::Constant(kMinBrickHalfSize));
+    near.rotation = AxisRotation::identity();
+    return collideShapeBrick(shape, pose, near, feature, speculativeMargin, out);
+  }
   if (!huge && shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box)
     return collideBoxes(shape.halfExtents, trShape, b.halfSize, trBrick, feature, b.material, speculativeMargin, out);
   // The brick as a Bullet shape: whole, or (huge) its part around the shape in coordinates
