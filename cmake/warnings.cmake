@@ -13,6 +13,11 @@ elseif(BW_SANITIZE STREQUAL "thread")
 elseif(NOT BW_SANITIZE STREQUAL "")
   message(FATAL_ERROR "BW_SANITIZE must be empty, address or thread (got '${BW_SANITIZE}')")
 endif()
+# note: the 24 axis rotations' composition table is computed at compile time; clang's default
+# constexpr step limit stops short of it.
+if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  target_compile_options(bw_build_options INTERFACE -fconstexpr-steps=50000000)
+endif()
 # BW_ASSERT (collision/core/assert.h) is checked in debug and under the sanitizers, never in the
 # release build the figures come from.
 if(CMAKE_BUILD_TYPE STREQUAL "Debug" OR NOT BW_SANITIZE STREQUAL "")

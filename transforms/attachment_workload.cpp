@@ -17,16 +17,23 @@ double unit(uint64_t bits) { return static_cast<double>(bits >> 11) * 0x1.0p-53;
 /// Uniform in [lo, hi) from a generator.
 double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * unit(rng()); }
 
+// note: every draw in its own statement: function arguments are evaluated in an unspecified
+// order (GCC right to left, clang left to right), so Quatf(draw(), draw(), ...) differs by compiler.
 Quatf randomRotation(std::mt19937_64& rng) {
-  Quatf q(static_cast<float>(uniform(rng, -1, 1)), static_cast<float>(uniform(rng, -1, 1)),
-          static_cast<float>(uniform(rng, -1, 1)), static_cast<float>(uniform(rng, -1, 1)));
+  const float w = static_cast<float>(uniform(rng, -1, 1));
+  const float x = static_cast<float>(uniform(rng, -1, 1));
+  const float y = static_cast<float>(uniform(rng, -1, 1));
+  const float z = static_cast<float>(uniform(rng, -1, 1));
+  Quatf q(w, x, y, z);
   if (q.squaredNorm() < 1e-6f) return Quatf::Identity();
   return q.normalized();
 }
 
 Vec3f randomVec(std::mt19937_64& rng, double lo, double hi) {
-  return Vec3f(static_cast<float>(uniform(rng, lo, hi)), static_cast<float>(uniform(rng, lo, hi)),
-               static_cast<float>(uniform(rng, lo, hi)));
+  const float x = static_cast<float>(uniform(rng, lo, hi));
+  const float y = static_cast<float>(uniform(rng, lo, hi));
+  const float z = static_cast<float>(uniform(rng, lo, hi));
+  return Vec3f(x, y, z);
 }
 
 }  // namespace

@@ -34,8 +34,10 @@ RayLoadStats RayLoad::fire(const RayLoadDescription& load, uint32_t frame, const
     ProfileZone zone(profiler, "rays", stage);
     for (uint32_t k = begin; k < end; ++k) {
       SeededRandom r(seed + k);
-      const Vec3d from(r.uniform(lo.x(), hi.x()), r.uniform(lo.y(), hi.y()), r.uniform(lo.z(), hi.z()));
-      const Vec3d to(r.uniform(lo.x(), hi.x()), r.uniform(lo.y(), hi.y()), r.uniform(lo.z(), hi.z()));
+      // note: one draw per statement, so the rays do not depend on the compiler's argument order.
+      Vec3d from, to;
+      for (int a = 0; a < 3; ++a) from[a] = r.uniform(lo[a], hi[a]);
+      for (int a = 0; a < 3; ++a) to[a] = r.uniform(lo[a], hi[a]);
       const double span = (to - from).norm();
       rays_[k].from = from;
       if (span == 0) continue;

@@ -99,9 +99,17 @@ uint32_t World::addGridBody(uint32_t gridIndex, const Vec3d& position, const Qua
 void World::spawn(const SpawnerDescription& s) {
   SeededRandom r(s.seed);
   for (uint32_t k = 0; k < s.count; ++k) {
-    const Vec3d p(r.uniform(s.regionMin.x(), s.regionMax.x()), r.uniform(s.regionMin.y(), s.regionMax.y()),
-                  r.uniform(s.regionMin.z(), s.regionMax.z()));
-    const Quatf q = Quatf(Eigen::AngleAxisf(float(r.uniform(0, 6.283)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized())).normalized();
+    // note: every draw in its own statement (argument evaluation order is unspecified in C++:
+    // GCC and clang differ), so a scene spawns the same bodies whatever the compiler.
+    const double px = r.uniform(s.regionMin.x(), s.regionMax.x());
+    const double py = r.uniform(s.regionMin.y(), s.regionMax.y());
+    const double pz = r.uniform(s.regionMin.z(), s.regionMax.z());
+    const Vec3d p(px, py, pz);
+    const float angle = float(r.uniform(0, 6.283));
+    const float ax = float(r.normal());
+    const float ay = float(r.normal());
+    const float az = float(r.normal());
+    const Quatf q = Quatf(Eigen::AngleAxisf(angle, Vec3f(ax, ay, az).normalized())).normalized();
     if (s.shape == SpawnerDescription::Shape::Grid) {
       // Grid copies keep their template's orientation (a ship is loaded upright); primitives
       // get a random one.

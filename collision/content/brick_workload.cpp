@@ -90,7 +90,9 @@ std::vector<Aabb> generatePlateStack(uint32_t plates, float size, uint64_t seed)
   float y = 0;
   for (uint32_t i = 0; i < plates; ++i) {
     const float thick = float(r.uniform(0.2, 0.4));
-    const Vec3f jitter(float(r.uniform(-2, 2)), 0.f, float(r.uniform(-2, 2)));
+    const float jx = float(r.uniform(-2, 2));  // one draw per statement: argument order is unspecified
+    const float jz = float(r.uniform(-2, 2));
+    const Vec3f jitter(jx, 0.f, jz);
     out.push_back({Vec3f(-size * 0.5f, y, -size * 0.5f) + jitter, Vec3f(size * 0.5f, y + thick, size * 0.5f) + jitter});
     y += thick;
   }

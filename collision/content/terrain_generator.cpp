@@ -8,7 +8,9 @@ namespace bw {
 
 void generateRandomTerrain(VoxelTerrain& t, uint32_t seed, float blobDensity) {
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
+  // note: std::mt19937 is fully specified, std::uniform_real_distribution is not (libstdc++
+  // and libc++ differ); the unit draw is written out so the terrain is the same everywhere.
+  auto u = [](std::mt19937& g) { return float(g() >> 8) * 0x1.0p-24f; };
   const Int3 s = t.size();
   const float fx = 0.05f + 0.2f * u(rng), fz = 0.05f + 0.2f * u(rng), ph = 6.f * u(rng);
   const int base = std::max(1, s.y / 3);
@@ -39,7 +41,7 @@ struct Waves {
   float f[4], p[4], a[4];
   explicit Waves(uint32_t seed) {
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(0.f, 1.f);
+    auto u = [](std::mt19937& g) { return float(g() >> 8) * 0x1.0p-24f; };  // as above
     for (int i = 0; i < 4; ++i) {
       f[i] = (0.004f + 0.03f * u(rng)) * float(1 << i);
       p[i] = 6.2831853f * u(rng);

@@ -56,7 +56,8 @@ std::vector<RigidTransform> restingPoses(const BrickGrid& g, float halfHeight, u
   std::vector<RigidTransform> out;
   const Aabb b = g.bounds();
   while (out.size() < count) {
-    const Vec3f o(float(r.uniform(b.min.x(), b.max.x())), float(r.uniform(b.min.y(), b.max.y())), b.max.z() + 5.f);
+    const float ox = float(r.uniform(b.min.x(), b.max.x())), oy = float(r.uniform(b.min.y(), b.max.y()));  // in this order
+    const Vec3f o(ox, oy, b.max.z() + 5.f);
     const GridRayHit h = g.raycast(Ray::make(o, Vec3f(0, 0, -1)), ~0u);
     if (!h.hit() || h.normal.z() < 0.9f) continue;
     const Vec3f p = o + Vec3f(0, 0, -h.t + halfHeight - 0.01f);
@@ -125,7 +126,8 @@ void GridEdit(benchmark::State& state) {
   SeededRandom r(5);
   const Aabb b = g.bounds();
   for (auto _ : state) {
-    const Vec3f p(float(r.uniform(b.min.x(), b.max.x())), float(r.uniform(b.min.y(), b.max.y())), float(r.uniform(b.min.z(), b.max.z())));
+    Vec3f p;
+    for (int a = 0; a < 3; ++a) p[a] = float(r.uniform(b.min[a], b.max[a]));  // one draw per statement
     const uint32_t id = g.placeBrick(Brick::box(p, Vec3f(0.2f, 0.2f, 0.24f)));
     g.removeBrick(id);
   }

@@ -294,7 +294,10 @@ std::vector<Vec3f> queryCentres(uint32_t count, uint64_t seed) {
 std::vector<Vec3f> rayDirections(uint32_t count, uint64_t seed) {
   bw::SeededRandom r(seed);
   std::vector<Vec3f> out;
-  for (uint32_t i = 0; i < count; ++i) out.push_back(Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized());
+  for (uint32_t i = 0; i < count; ++i) {
+    const float x = float(r.normal()), y = float(r.normal()), z = float(r.normal());  // in this order
+    out.push_back(Vec3f(x, y, z).normalized());
+  }
   return out;
 }
 

@@ -40,11 +40,17 @@ Bodies makeBodies(uint32_t n) {
   Bodies b;
   for (uint32_t i = 0; i < n; ++i) {
     const bool grid = i < 4;  // four large static grids
-    const Vec3d c(r.uniform(0, 500), r.uniform(0, 500), grid ? 10 : r.uniform(0, 60));
+    const double cx = r.uniform(0, 500), cy = r.uniform(0, 500), cz = grid ? 10 : r.uniform(0, 60);  // in this order
+    const Vec3d c(cx, cy, cz);
     const Vec3d h = grid ? Vec3d(200, 200, 20) : Vec3d::Constant(0.25);
     b.bounds.push_back({c - h, c + h});
     b.isStatic.push_back(grid);
-    b.velocity.push_back(grid ? Vec3d::Zero() : Vec3d(r.normal(), r.normal(), -r.uniform(0, 5)));
+    if (grid) {
+      b.velocity.push_back(Vec3d::Zero());
+    } else {
+      const double vx = r.normal(), vy = r.normal(), vz = -r.uniform(0, 5);  // in this order
+      b.velocity.push_back(Vec3d(vx, vy, vz));
+    }
   }
   return b;
 }

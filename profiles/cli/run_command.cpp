@@ -99,7 +99,8 @@ int runOctoBvhStress(uint32_t elements, uint64_t seed, bool json) {
   const double overlapMs = msSince(t);
   t = Clock::now();
   for (uint32_t q = 0; q < kQueries; ++q) {
-    const Vec3f dir = Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized();
+    const float dx = float(r.normal()), dy = float(r.normal()), dz = float(r.normal());  // in this order
+    const Vec3f dir = Vec3f(dx, dy, dz).normalized();
     const Vec3f o = bricks[r.below(elements)].center() + dir * 3.f;
     rayHits += tree.raycastClosest(Ray::make(o, dir, 200.f), 1, &rayStats).hit();
   }
