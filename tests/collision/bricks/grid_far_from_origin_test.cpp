@@ -26,14 +26,7 @@
 namespace bw {
 namespace {
 
-using test::BruteRayHit;
-using test::BruteSweepHit;
-using test::bruteSweep;
-using test::describeRay;
-using test::expectRayMatches;
-using test::handleOfBrick;
-using test::kInf;
-using test::lowestHandleBrick;
+using namespace test;  // the shared brute-force helpers (collision/support/extremes_support.h)
 
 // A small build: a floor of plates, a wedge, a cylinder and microbricks, all shifted by `offset`
 // in the grid's own frame.

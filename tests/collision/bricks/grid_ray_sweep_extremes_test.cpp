@@ -26,14 +26,7 @@
 namespace bw {
 namespace {
 
-using test::BruteRayHit;
-using test::BruteSweepHit;
-using test::bruteSweep;
-using test::describeRay;
-using test::expectRayMatches;
-using test::handleOfBrick;
-using test::kInf;
-using test::lowestHandleBrick;
+using namespace test;  // the shared brute-force helpers (collision/support/extremes_support.h)
 
 // Unit cubes [x,x+1]x[y,y+1]x[z,z+1] on a 6x6x3 lattice with seeded holes; a solid 2x2x2 block
 // over [10,12]x[0,2]x[0,2] whose centre (11,1,1) is a corner shared by 8 bricks; a row of unit

@@ -23,14 +23,7 @@
 namespace bw {
 namespace {
 
-using test::BruteRayHit;
-using test::BruteSweepHit;
-using test::bruteSweep;
-using test::describeRay;
-using test::expectRayMatches;
-using test::handleOfBrick;
-using test::kInf;
-using test::lowestHandleBrick;
+using namespace test;  // the shared brute-force helpers (collision/support/extremes_support.h)
 
 // 500-long ramps (wedges, half size 250 x 2 x 3) in several rotations, 0.04-thick plates, and
 // 0.04 microbricks beside the ramps, on the plates and scattered: size ratio 12500.
