@@ -1,6 +1,7 @@
 #include "world/body_store.h"
 
 #include "collision/core/argument_checks.h"
+#include "world/world_tuning.h"
 
 namespace bw {
 
@@ -20,7 +21,7 @@ uint32_t BodyStore::add(const Vec3d& pos, const Quatf& rot, MotionType m, const 
   motion.push_back(m);
   shape.push_back(s);
   shapeFromBody.push_back(shapeFrame);
-  friction.push_back(0.6f);
+  friction.push_back(tuning::kDefaultFriction);
   return uint32_t(position.size() - 1);
 }
 

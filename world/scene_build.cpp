@@ -105,7 +105,7 @@ void World::spawn(const SpawnerDescription& s) {
     const double py = r.uniform(s.regionMin.y(), s.regionMax.y());
     const double pz = r.uniform(s.regionMin.z(), s.regionMax.z());
     const Vec3d p(px, py, pz);
-    const float angle = float(r.uniform(0, 6.283));
+    const float angle = float(r.uniform(0, 6.283));  // a random turn about a random axis (6.283 ~ 2 pi)
     const float ax = float(r.normal());
     const float ay = float(r.normal());
     const float az = float(r.normal());

@@ -5,6 +5,10 @@
 
 namespace bw::tuning {
 
+// --- Bodies -------------------------------------------------------------------------------
+/// Coulomb friction coefficient of every body (a pair uses sqrt(fa * fb)): rough plastic.
+inline constexpr float kDefaultFriction = 0.6f;
+
 // --- Broadphase and speculative contacts --------------------------------------------------
 /// Body bounds grow by this (m) beyond how far the body can move in one frame, so resting
 /// bodies keep their pairs through small motions and pairs are not found one frame late.
