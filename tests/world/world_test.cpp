@@ -23,7 +23,8 @@ TEST(World, BoxDroppedOnAGridComesToRestOnIt) {
   // Resting on a face: its centre 0.25 above the floor top (z = 0), within solver slop.
   EXPECT_NEAR(b.position[1].z(), 0.25, 0.02);
   EXPECT_LT(b.linearVelocity[1].norm(), 0.05f);
-  EXPECT_NEAR(b.position[1].x(), 1.0, 0.5);
+  // It may tumble on landing (its orientation is random): within two box widths of where it fell.
+  EXPECT_NEAR(b.position[1].x(), 1.0, 1.0);
 }
 
 TEST(World, TenBoxStackStaysStanding) {
