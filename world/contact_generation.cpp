@@ -16,6 +16,8 @@ float World::closingSpeed(uint32_t a, uint32_t b) const {
 }
 
 bool World::canCollide(uint32_t a, uint32_t b) const {
+  // A body on its way out of solid is a ghost: it touches nothing until it is let go.
+  if (!depenetrating_.empty() && (ghost_[a] || ghost_[b])) return false;
   return bodies_.inverseMass[a] > 0.f || bodies_.inverseMass[b] > 0.f;
 }
 

@@ -9,6 +9,25 @@ namespace bw {
 
 using namespace tuning;
 
+namespace {
+// The radius a body rolls on: spheres and capsules roll, every other shape rests on faces.
+float rollingRadius(const BodyShape& shape) {
+  if (shape.isGrid() || shape.isTerrain()) return 0.f;
+  const QueryShape::Kind k = shape.primitive.kind;
+  return k == QueryShape::Kind::Sphere || k == QueryShape::Kind::Capsule ? shape.primitive.radius : 0.f;
+}
+
+// Coulomb's cone: the friction impulse (t1, t2) is scaled back to length `limit` when longer.
+// note: clamping each tangent on its own (a pyramid) pushes sideways to the sliding direction:
+// a capsule landing on its end came away rolling about its own axis at up to 4 rad/s.
+void clampToFrictionCone(float t1, float t2, float limit, float& out1, float& out2) {
+  const float length2 = t1 * t1 + t2 * t2;
+  const float scale = length2 > limit * limit ? limit / std::sqrt(length2) : 1.f;
+  out1 = t1 * scale;
+  out2 = t2 * scale;
+}
+}  // namespace
+
 void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs,
                             const std::vector<std::vector<Contact>>& pairContacts, const std::vector<uint8_t>& flipped,
                             const SceneSettings& settings, float dt) {
@@ -62,6 +81,15 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
         }
       }
       s.friction = std::sqrt(bodies.friction[a] * bodies.friction[b]);
+      s.rolling = settings.rollingResistance * std::max(rollingRadius(bodies.shape[a]), rollingRadius(bodies.shape[b]));
+      if (s.rolling > 0.f)
+        for (int d = 0; d < 2; ++d) {
+          const Vec3f axis = d == 0 ? s.t1 : s.t2;
+          s.rollA[d] = iA * axis;
+          s.rollB[d] = iB * axis;
+          const float m = axis.dot(s.rollA[d]) + axis.dot(s.rollB[d]);
+          s.massR[d] = m > 0 ? 1.f / m : 0.f;
+        }
       const Vec3f vRel = bodies.linearVelocity[a] + bodies.angularVelocity[a].cross(s.rA) - bodies.linearVelocity[b] -
                          bodies.angularVelocity[b].cross(s.rB);
       const float vn = vRel.dot(n);
@@ -139,10 +167,25 @@ void ContactSolver::solveContact(SolverContact& s, bool relax) {
   const float limit = s.friction * s.lambdaN;
   const Vec3f v = relative();
   const float o1 = s.lambdaT1, o2 = s.lambdaT2;
-  s.lambdaT1 = std::clamp(o1 - s.massT1 * v.dot(s.t1), -limit, limit);
-  s.lambdaT2 = std::clamp(o2 - s.massT2 * v.dot(s.t2), -limit, limit);
+  clampToFrictionCone(o1 - s.massT1 * v.dot(s.t1), o2 - s.massT2 * v.dot(s.t2), limit, s.lambdaT1, s.lambdaT2);
   applyImpulse(s, 1, s.t1, s.lambdaT1 - o1);
   applyImpulse(s, 2, s.t2, s.lambdaT2 - o2);
+  if (s.rolling > 0.f) resistRolling(s);
+}
+
+// Rolling resistance: the relative spin about the two tangent axes (rolling, not spinning about
+// the normal) is opposed by an angular impulse within a cone of rolling x lambdaN, as friction
+// opposes sliding. Without it a capsule that lands spinning about its axis rolls forever and
+// never sleeps.
+void ContactSolver::resistRolling(SolverContact& s) {
+  SolverBody& a = bodies_[s.a];
+  SolverBody& b = bodies_[s.b];
+  const Vec3f w = a.w - b.w;
+  const float o1 = s.lambdaR1, o2 = s.lambdaR2;
+  clampToFrictionCone(o1 - s.massR[0] * w.dot(s.t1), o2 - s.massR[1] * w.dot(s.t2), s.rolling * s.lambdaN, s.lambdaR1, s.lambdaR2);
+  const float d1 = s.lambdaR1 - o1, d2 = s.lambdaR2 - o2;
+  if (a.dynamic) a.w += s.rollA[0] * d1 + s.rollA[1] * d2;
+  if (b.dynamic) b.w -= s.rollB[0] * d1 + s.rollB[1] * d2;
 }
 
 // Shock propagation (Guendelman et al.): after the iterations, one sweep from the bottom of the
@@ -170,8 +213,7 @@ void ContactSolver::solveContactShock(SolverContact& s) {
   const float limit = s.friction * s.lambdaN;
   const Vec3f v = relative();
   const float o1 = s.lambdaT1, o2 = s.lambdaT2;
-  s.lambdaT1 = std::clamp(o1 - s.shockMass[1] * v.dot(s.t1), -limit, limit);
-  s.lambdaT2 = std::clamp(o2 - s.shockMass[2] * v.dot(s.t2), -limit, limit);
+  clampToFrictionCone(o1 - s.shockMass[1] * v.dot(s.t1), o2 - s.shockMass[2] * v.dot(s.t2), limit, s.lambdaT1, s.lambdaT2);
   push(1, s.t1, s.lambdaT1 - o1);
   push(2, s.t2, s.lambdaT2 - o2);
 }

@@ -52,6 +52,7 @@ class ContactSolver {
   void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
   void warmStart(const SolverContact& s);
   void solveContact(SolverContact& s, bool relax);
+  void resistRolling(SolverContact& s);
   void solveContactShock(SolverContact& s);
   void shockSweep(std::vector<uint32_t>& contacts);
   void solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings);

@@ -21,7 +21,7 @@ const char* insideSolidName(InsideSolid reason) {
 
 InsideSolid World::pointInsideSolid(const Vec3d& p, uint32_t self) const {
   thread_local std::vector<uint32_t> candidates;
-  for (uint32_t g = 0; g < bodies_.size(); ++g) {
+  for (uint32_t g : solidBodies_) {
     const BodyShape& shape = bodies_.shape[g];
     if (g == self) continue;
     if (shape.isGrid()) {
@@ -45,7 +45,7 @@ bool World::segmentHitsStatic(const Vec3d& from, const Vec3d& to) {
   const double length = (to - from).norm();
   if (!(length > 0)) return false;
   const Vec3d dir = (to - from) / length;
-  for (uint32_t g = 0; g < bodies_.size(); ++g) {
+  for (uint32_t g : solidBodies_) {
     const BodyShape& shape = bodies_.shape[g];
     if (bodies_.motion[g] == MotionType::Dynamic) continue;
     if (shape.isGrid()) {
@@ -67,6 +67,10 @@ ContainmentTracker::ContainmentTracker(World& world) : world_(world) {
   state_.assign(bodies.size(), InsideSolid::No);
   for (uint32_t i = 0; i < bodies.size(); ++i)
     if (bodies.motion[i] == MotionType::Dynamic) state_[i] = world.pointInsideSolid(bodies.position[i], i);
+  // A body first seen inside solid (or kinematic, being pushed out of it) has no clear place
+  // yet: the first place it is seen clear becomes one.
+  hasClear_.assign(bodies.size(), 0);
+  for (uint32_t i = 0; i < bodies.size(); ++i) hasClear_[i] = bodies.motion[i] == MotionType::Dynamic && state_[i] == InsideSolid::No;
   report_ = {};
   for (uint32_t i = 0; i < bodies.size(); ++i)
     if (state_[i] != InsideSolid::No) {
@@ -85,8 +89,11 @@ const ContainmentReport& ContainmentTracker::update() {
     if (p != lastSeen_[i]) {
       lastSeen_[i] = p;
       InsideSolid s = world_.pointInsideSolid(p, i);
-      if (s == InsideSolid::No && world_.segmentHitsStatic(lastClear_[i], p)) s = InsideSolid::WentThrough;
-      if (s == InsideSolid::No) lastClear_[i] = p;
+      if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsStatic(lastClear_[i], p)) s = InsideSolid::WentThrough;
+      if (s == InsideSolid::No) {
+        lastClear_[i] = p;
+        hasClear_[i] = 1;
+      }
       state_[i] = s;
     }
     if (state_[i] != InsideSolid::No) {

@@ -55,6 +55,7 @@ class ContainmentTracker {
   World& world_;
   std::vector<Vec3d> lastSeen_;   // per body: centre at the last update
   std::vector<Vec3d> lastClear_;  // per body: the last centre seen outside solid
+  std::vector<uint8_t> hasClear_; // per body: lastClear_ is set (not for a body that started inside)
   std::vector<InsideSolid> state_;
   ContainmentReport report_;
 };

@@ -90,6 +90,9 @@ struct RayLoadDescription {
   uint64_t seed = 1;
 };
 
+/// What the world does with a dynamic body that starts inside solid (depenetration.h).
+enum class StartInSolid : uint8_t { PushOut, Refuse };
+
 /// Global settings of a run.
 struct SceneSettings {
   Vec3d gravity{0, 0, -9.81};
@@ -97,6 +100,11 @@ struct SceneSettings {
   int substeps = 1;
   int solverIterations = 8;
   int relaxIterations = 2;           ///< velocity iterations after integration without push-out
+  /// Rolling resistance of spheres and capsules: a contact resists rolling with at most this
+  /// times the round body's radius times its normal impulse (0 rolls forever).
+  float rollingResistance = 0.1f;
+  StartInSolid startInSolid = StartInSolid::PushOut;  ///< bodies that start inside solid
+  float depenetrationSpeed = 5.f;    ///< m/s at which they are pushed out
   bool shockPropagation = false;     ///< a last bottom-up sweep treating the lower body as immovable
   uint32_t frames = 300;
   float lodFraction = 1.f / 16;

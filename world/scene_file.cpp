@@ -234,7 +234,8 @@ SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescriptio
 
 SceneSettings parseSettings(const Field& f) {
   f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping",
-               "manifold_size", "reuse_translation", "reuse_rotation", "relax_iterations", "shock_propagation"});
+               "manifold_size", "reuse_translation", "reuse_rotation", "relax_iterations", "shock_propagation",
+               "rolling_resistance", "start_in_solid", "depenetration_speed"});
   SceneSettings s;
   if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-scene_limits::kMaxGravity, scene_limits::kMaxGravity);
   if (f.has("timestep")) s.timestep = f.at("timestep").number(scene_limits::kMinTimestep, scene_limits::kMaxTimestep);
@@ -246,6 +247,12 @@ SceneSettings parseSettings(const Field& f) {
   if (f.has("sleeping")) s.sleeping = f.at("sleeping").boolean();
   if (f.has("shock_propagation")) s.shockPropagation = f.at("shock_propagation").boolean();
   if (f.has("relax_iterations")) s.relaxIterations = int(f.at("relax_iterations").integer(0, scene_limits::kMaxRelaxIterations));
+  if (f.has("start_in_solid")) {
+    const std::string policy = f.at("start_in_solid").oneOf({"push_out", "refuse"});
+    s.startInSolid = policy == "refuse" ? StartInSolid::Refuse : StartInSolid::PushOut;
+  }
+  if (f.has("depenetration_speed")) s.depenetrationSpeed = float(f.at("depenetration_speed").number(0.01, scene_limits::kMaxSpeed));
+  if (f.has("rolling_resistance")) s.rollingResistance = float(f.at("rolling_resistance").number(0, 1));
   if (f.has("manifold_size")) s.manifoldSize = int(f.at("manifold_size").integer(1, scene_limits::kMaxManifoldSize));
   if (f.has("reuse_translation")) s.reuseTranslation = f.at("reuse_translation").number(0, 1);
   if (f.has("reuse_rotation")) s.reuseRotation = float(f.at("reuse_rotation").number(0, 1));

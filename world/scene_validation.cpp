@@ -57,6 +57,8 @@ void validateScene(const SceneDescription& scene) {
   c.number("settings.lod_fraction", s.lodFraction, 0, 1);
   c.number("settings.approximation_depth", s.approximationDepth, 0, kMaxApproximationDepth);
   c.number("settings.relax_iterations", s.relaxIterations, 0, kMaxRelaxIterations);
+  c.number("settings.rolling_resistance", s.rollingResistance, 0, 1);
+  c.number("settings.depenetration_speed", s.depenetrationSpeed, 0.01, kMaxSpeed);
   c.number("settings.manifold_size", s.manifoldSize, 1, kMaxManifoldSize);
   c.number("settings.reuse_translation", s.reuseTranslation, 0, 1);
   c.number("settings.reuse_rotation", s.reuseRotation, 0, 1);

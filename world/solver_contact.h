@@ -26,6 +26,12 @@ struct SolverContact {
   uint8_t shockLower = 0;
   double height = 0;
   float lambdaN = 0, lambdaT1 = 0, lambdaT2 = 0;
+  // Rolling resistance (a sphere or capsule in the pair): angular impulses about t1 and t2,
+  // bounded by rolling x lambdaN; the bodies' angular response to each (inverse inertia x axis).
+  float rolling = 0;     // coefficient x the round body's radius (m); 0: none
+  Vec3f rollA[2], rollB[2];
+  float massR[2];
+  float lambdaR1 = 0, lambdaR2 = 0;
 };
 
 /// A body's velocities as the solver reads and writes them: one 32-byte record per body

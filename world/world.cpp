@@ -6,6 +6,7 @@
 
 #include "collision/core/argument_checks.h"
 #include "collision/core/hash.h"
+#include "world/body_mass.h"
 #include "world/scene_validation.h"
 
 namespace bw {
@@ -21,7 +22,10 @@ World::World(const SceneDescription& scene, int threads) : scene_((validateScene
   for (const GridDescription& g : scene_.grids) buildGrid(g);
   for (const TerrainDescription& t : scene_.terrains) buildTerrain(t);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
+  for (uint32_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) solidBodies_.push_back(i);
   sleep_.reset(bodies_.size());
+  resolveStartsInSolid();
 }
 
 const BrickGrid& World::grid(uint32_t index) const {
@@ -132,6 +136,8 @@ void World::applyGridEdits() {
   for (uint32_t g : editedGrids_) edited[g] = 1;
   editedGrids_.clear();
   auto usesEdited = [&](uint32_t body) { return bodies_.shape[body].isGrid() && edited[bodies_.shape[body].grid]; };
+  for (uint32_t body = 0; body < bodies_.size(); ++body)
+    if (usesEdited(body) && bodies_.motion[body] == MotionType::Dynamic) refreshGridBodyMass(body);
   for (const BodyPair& p : pairs_) {
     if (!usesEdited(p.a) && !usesEdited(p.b)) continue;
     for (uint32_t x : {p.a, p.b}) sleep_.wake(x);
@@ -139,13 +145,36 @@ void World::applyGridEdits() {
   pairCache_.forget([&](const BodyPair& p) { return usesEdited(p.a) || usesEdited(p.b); });
 }
 
+void World::refreshGridBodyMass(uint32_t body) {
+  const MassProperties mass = grids_[bodies_.shape[body].grid]->massProperties();
+  // note: a grid edited down to nothing keeps its last mass: it collides with nothing, but a
+  // body with zero mass would break the solver's and integrator's divisions.
+  if (!(mass.mass > 0)) return;
+  // The grid stays where it is; the body frame (centre of mass, principal axes) moves inside
+  // it. Every remaining brick keeps its velocity, so the new centre of mass moves at v + w x r
+  // (r from the old centre to the new) and the spin is unchanged.
+  const RigidTransform gridPose = bodies_.shapePose(body);
+  const GridBodyFrame frame = gridBodyFrame(mass);
+  const RigidTransform bodyPose = gridPose * frame.bodyInGrid;
+  const Vec3f r = (bodyPose.translation - bodies_.position[body]).cast<float>();
+  bodies_.linearVelocity[body] += bodies_.angularVelocity[body].cross(r);
+  bodies_.position[body] = bodyPose.translation;
+  bodies_.rotation[body] = bodyPose.rotation;
+  bodies_.shapeFromBody[body] = frame.bodyInGrid.inverse();
+  bodies_.inverseMass[body] = frame.inverseMass;
+  bodies_.inverseInertia[body] = frame.inverseInertia;
+  sleep_.wake(body);
+}
+
 void World::step() {
   const auto t = Clock::now();
   stats_ = StepStats{};
   applyGridEdits();
+  advanceDepenetration();
   profiler_.beginFrame(frame_);
   const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
   for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt, s);
+  finishDepenetration();
   {
     ProfileZone z(profiler_, "rays (stage)");
     const auto rays = Clock::now();

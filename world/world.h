@@ -28,6 +28,7 @@
 #include "world/broadphase.h"
 #include "world/containment.h"
 #include "world/contact_solver.h"
+#include "world/depenetration.h"
 #include "world/islands.h"
 #include "world/pair_cache.h"
 #include "world/ray_load.h"
@@ -78,7 +79,8 @@ class World {
   const BrickGrid& grid(uint32_t index) const;
   /// Grid `index` (< gridCount(), else InvalidInput) to edit: place or remove bricks between
   /// steps; every body using it sees the edit at the next step, bodies resting on it wake and
-  /// its cached contacts are dropped. Not while step() runs.
+  /// its cached contacts are dropped; a dynamic body using it takes the grid's new mass, centre
+  /// of mass and inertia, every remaining brick keeping its velocity. Not while step() runs.
   BrickGrid& editGrid(uint32_t index);
   /// Hash of every body's position, rotation and velocities (bit patterns): equal hashes mean
   /// bit-identical states. The same for any thread count.
@@ -98,6 +100,10 @@ class World {
   /// unchanged; the next step() makes its own contacts again. Returns one list per pair().
   const std::vector<std::vector<Contact>>& probeContacts(float lodFraction, int approximationDepth, int manifoldSize,
                                                          uint64_t* boxTests = nullptr);
+  /// Dynamic bodies that started inside solid (pushed out, see depenetration.h).
+  uint32_t startedInSolid() const { return startedInSolid_; }
+  /// Of those, the ones still on their way out (kinematic until they arrive).
+  uint32_t depenetratingCount() const { return uint32_t(depenetrating_.size()); }
   /// Dynamic bodies currently asleep.
   uint32_t sleepingCount() const { return sleep_.count(); }
   /// Whether point `p` (world) is inside a brick of any grid body but `self`, or in a solid
@@ -117,6 +123,12 @@ class World {
   void spawn(const SpawnerDescription& s);
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
+  // Bodies that start inside solid (depenetration.cpp).
+  void resolveStartsInSolid();
+  float deepestStaticOverlap(uint32_t body, const Vec3d& position, ContactScratch& scratch, std::vector<Contact>& contacts);
+  void advanceDepenetration();
+  void finishDepenetration();
+  std::string bodySource(uint32_t body) const;
   // Bounds and contacts (contact_generation.cpp, terrain_pairs.cpp).
   void computeBounds();
   void generateContacts(float dt);
@@ -131,6 +143,8 @@ class World {
   void substep(float dt, int index);
   void integrate(float dt);
   void applyGridEdits();
+  /// A dynamic grid body's mass, centre of mass and inertia after its grid was edited.
+  void refreshGridBodyMass(uint32_t body);
   // Profiling stages per substep: broadphase, contacts, prepare, solve, integrate, relax.
   static constexpr int kStagesPerSubstep = 6;
 
@@ -144,6 +158,10 @@ class World {
   std::vector<std::unique_ptr<Terrain>> terrains_;
   std::vector<float> waterDensity_;
   BodyStore bodies_;
+  std::vector<uint32_t> solidBodies_;  // grid and terrain bodies, ascending (what bodies can be inside)
+  std::vector<Depenetration> depenetrating_;
+  std::vector<uint8_t> ghost_;  // per body: on its way out of solid (collides with nothing)
+  uint32_t startedInSolid_ = 0;
   std::vector<WorldAabb> bounds_;
   std::vector<uint8_t> isStatic_;
   std::vector<float> reach_;  // per body: speed + spin x radius (m/s), from computeBounds()

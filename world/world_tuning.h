@@ -21,7 +21,7 @@ inline constexpr float kSpeculativeMargin = 0.01f;
 /// Baumgarte factor: the share of the penetration (beyond kSlop) pushed out per step.
 inline constexpr float kBaumgarte = 0.2f;
 /// Penetration left alone (m): resting contacts keep a little overlap, so they do not flicker.
-inline constexpr float kSlop = 0.005f;
+inline constexpr float kSlop = 0.0015f;
 /// Restitution of impacts faster than kBounceThreshold (m/s); slower ones do not bounce, so
 /// resting bodies do not jitter.
 inline constexpr float kRestitution = 0.1f;

@@ -190,6 +190,8 @@ int runScene(const SceneRunOptions& o) {
                      {"dynamic_moving", moving},
                      {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
                      {"bodies_inside_solid", inside.count()},
+                     {"bodies_started_in_solid", world.startedInSolid()},
+                     {"bodies_being_pushed_out", world.depenetratingCount()},
                      {"state_hash", world.stateHash()}};
     if (inside.count()) {
       nlohmann::json list = nlohmann::json::array();
@@ -237,7 +239,8 @@ int runScene(const SceneRunOptions& o) {
     std::printf("  terrain: %.0f contacts per frame, %u bodies in water at the end\n", double(terrainContacts) / frames, floating);
   std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
               world.sleepingCount(), moving, std::isfinite(lowest) ? lowest : 0.0);
-  std::printf("  bodies inside solid at the end: %u\n", inside.count());
+  std::printf("  bodies inside solid at the end: %u (%u started inside solid and were pushed out, %u still on their way)\n",
+              inside.count(), world.startedInSolid(), world.depenetratingCount());
   for (uint32_t k = 0; k < inside.count() && k < 5; ++k) {
     const Vec3d& p = bodies.position[inside.bodies[k]];
     std::printf("    body %u at (%.2f, %.2f, %.2f): %s\n", inside.bodies[k], p.x(), p.y(), p.z(), insideSolidName(inside.reasons[k]));

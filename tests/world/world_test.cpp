@@ -105,5 +105,64 @@ TEST(World, ShockPropagationAndColouredIslandsAreIdenticalForAnyThreadCount) {
   EXPECT_GT(split, 0u) << "the pile must form an island big enough to be coloured";
 }
 
+// An L of three bricks flies and spins with no gravity; one arm is removed between steps. The
+// body must take the two remaining bricks' mass, centre of mass and inertia, and every remaining
+// brick keep its velocity: from then on it moves exactly as a world built with only those two
+// bricks, placed where the grid was and moving as its bricks moved.
+GridDescription flyingL(std::vector<Brick> bricks, const Vec3d& position, const Quatf& rotation, const Vec3d& velocity,
+                        const Vec3f& spin) {
+  GridDescription g;
+  g.name = "l";
+  g.bricks = std::move(bricks);
+  g.position = position;
+  g.rotation = rotation;
+  g.motion = MotionType::Dynamic;
+  g.kinematic.linearVelocity = velocity;
+  g.kinematic.angularVelocity = spin;
+  return g;
+}
+
+TEST(World, DynamicGridTakesItsNewMassAfterAnEditAndItsBricksKeepTheirVelocity) {
+  const Brick corner = Brick::box(Vec3f(0, 0, 0), Vec3f::Constant(0.5f)), armX = Brick::box(Vec3f(1, 0, 0), Vec3f::Constant(0.5f)),
+              armY = Brick::box(Vec3f(0, 2, 0), Vec3f(0.5f, 1.5f, 0.5f));
+  SceneDescription scene;
+  scene.name = "edit_mass";
+  scene.settings.gravity = Vec3d::Zero();
+  scene.grids = {flyingL({corner, armX, armY}, Vec3d(3, -2, 7), Quatf::Identity(), Vec3d(1, 2, -0.5), Vec3f(0.3f, -0.2f, 0.9f))};
+  World edited(scene, 1);
+  for (int f = 0; f < 10; ++f) edited.step();
+  const float massBefore = 1.f / edited.bodies().inverseMass[0];
+  // The brick ids are the scene's order; remove the x arm.
+  ASSERT_EQ(edited.grid(0).brick(1).position, armX.position);
+  edited.editGrid(0).removeBrick(1);
+
+  // The reference: the two remaining bricks where the grid is now, the centre of mass moving as
+  // that point of the three-brick body moved (v + w x r).
+  const BodyStore& b = edited.bodies();
+  const RigidTransform gridPose = b.shapePose(0);
+  const MassProperties two = edited.grid(0).massProperties();
+  const Vec3d newCentre = gridPose.pointToWorld(two.centerOfMass.cast<float>());
+  const Vec3f w = b.angularVelocity[0];
+  const Vec3f v = b.linearVelocity[0] + w.cross((newCentre - b.position[0]).cast<float>());
+  SceneDescription remaining = scene;
+  remaining.grids = {flyingL({corner, armY}, gridPose.translation, gridPose.rotation, v.cast<double>(), w)};
+  World reference(remaining, 1);
+
+  for (int f = 0; f < 60; ++f) {
+    edited.step();
+    reference.step();
+  }
+  const BodyStore& r = reference.bodies();
+  EXPECT_NEAR(1.f / b.inverseMass[0], massBefore * 0.8f, massBefore * 1e-4f) << "the x arm was a fifth of the mass";
+  EXPECT_NEAR(b.inverseMass[0], r.inverseMass[0], r.inverseMass[0] * 1e-5f);
+  EXPECT_LT((b.inverseInertia[0] - r.inverseInertia[0]).norm(), r.inverseInertia[0].norm() * 1e-4f);
+  EXPECT_LT((b.position[0] - r.position[0]).norm(), 1e-4) << "centre of mass";
+  EXPECT_LT((b.linearVelocity[0] - r.linearVelocity[0]).norm(), 1e-4f);
+  EXPECT_LT((b.angularVelocity[0] - r.angularVelocity[0]).norm(), 1e-5f);
+  const RigidTransform poseE = b.shapePose(0), poseR = r.shapePose(0);
+  EXPECT_LT((poseE.translation - poseR.translation).norm(), 1e-4) << "the grid's origin";
+  EXPECT_LT(poseE.rotation.angularDistance(poseR.rotation), 1e-4f) << "the grid's orientation";
+}
+
 }  // namespace
 }  // namespace bw
