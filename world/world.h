@@ -14,8 +14,9 @@
 /// starting matched by contact feature, a relax pass after integration), islands solved in
 /// parallel, islands above kSplitContacts coloured (no two contacts of a colour share a dynamic
 /// body) and solved colour by colour on every thread, sleeping, and substeps. Terrain pairs run
-/// on one thread (the chunk cache is filled by queries); water voxels float bodies. Thread
-/// safety: one step() at a time; editGrid() and probeContacts() only between steps.
+/// on one thread (the chunk cache is filled by queries); water voxels float bodies. Bodies that
+/// start inside solid are pushed out or refused (depenetration.h). Thread safety: one step()
+/// at a time; editGrid() and probeContacts() only between steps.
 #include <cstdint>
 #include <memory>
 #include <vector>

@@ -21,6 +21,8 @@ inline constexpr float kSpeculativeMargin = 0.01f;
 /// Baumgarte factor: the share of the penetration (beyond kSlop) pushed out per step.
 inline constexpr float kBaumgarte = 0.2f;
 /// Penetration left alone (m): resting contacts keep a little overlap, so they do not flicker.
+/// note: bodies settle at up to this depth; 5 mm left capsules 5 mm deep in the floor, and
+/// resting within 2 mm is the goal (stacks stay put at 1.5 mm: tested).
 inline constexpr float kSlop = 0.0015f;
 /// Restitution of impacts faster than kBounceThreshold (m/s); slower ones do not bounce, so
 /// resting bodies do not jitter.
