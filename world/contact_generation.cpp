@@ -2,6 +2,9 @@
 // (primitive vs grid through the grid's query, grid vs grid through the smaller grid's convex
 // approximation, primitive pairs directly), each pair writing its own slot, with speculative
 // margins and the pair cache. Pairs with a terrain are made afterwards (terrain_pairs.cpp).
+#include <string>
+
+#include "collision/core/errors.h"
 #include "world/scene_validation.h"
 #include "world/world.h"
 #include "world/world_tuning.h"
@@ -21,37 +24,47 @@ bool World::canCollide(uint32_t a, uint32_t b) const {
   return bodies_.inverseMass[a] > 0.f || bodies_.inverseMass[b] > 0.f;
 }
 
+WorldAabb World::boundsOf(uint32_t i, float& reach) const {
+  const RigidTransform pose = bodies_.shapePose(i);
+  const Mat3f R = pose.rotation.toRotationMatrix().cwiseAbs();
+  Vec3d centre, half;
+  if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) {
+    Aabb b;
+    if (bodies_.shape[i].isGrid()) {
+      b = grids_[bodies_.shape[i].grid]->bounds();
+    } else {
+      const Terrain& t = *terrains_[bodies_.shape[i].terrain];
+      const Int3 size = t.voxels().size();
+      b = {Vec3f::Zero(), Vec3f(float(size.x), float(size.y), float(size.z)) * t.voxelSize()};
+    }
+    centre = pose.pointToWorld(b.center());
+    half = (R * b.halfExtent()).cast<double>();
+  } else {
+    centre = pose.translation;
+    half = (R * bodies_.shape[i].primitive.localHalfExtents()).cast<double>();
+  }
+  // How far any point of the body can move per second: its speed plus its spin times its
+  // radius about the centre of mass (a spinning capsule's ends outrun its centre).
+  const double radius = (centre - bodies_.position[i]).norm() + half.norm();
+  reach = float(double(bodies_.linearVelocity[i].norm()) + double(bodies_.angularVelocity[i].norm()) * radius);
+  // A margin of how far the body can move this frame keeps fast bodies in their pairs.
+  const double margin = tuning::kBroadphaseMargin + double(reach) * scene_.settings.timestep;
+  return {centre - half - Vec3d::Constant(margin), centre + half + Vec3d::Constant(margin)};
+}
+
+WorldAabb World::broadphaseBounds(uint32_t body) const {
+  if (body >= bodies_.size()) throw InvalidInput("World::broadphaseBounds: no body " + std::to_string(body));
+  float reach;
+  return boundsOf(body, reach);
+}
+
 void World::computeBounds() {
   const uint32_t n = bodies_.size();
   bounds_.resize(n);
   isStatic_.resize(n);
   reach_.resize(n);
   for (uint32_t i = 0; i < n; ++i) {
-    const RigidTransform pose = bodies_.shapePose(i);
-    const Mat3f R = pose.rotation.toRotationMatrix().cwiseAbs();
-    Vec3d centre, half;
-    if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) {
-      Aabb b;
-      if (bodies_.shape[i].isGrid()) {
-        b = grids_[bodies_.shape[i].grid]->bounds();
-      } else {
-        const Terrain& t = *terrains_[bodies_.shape[i].terrain];
-        const Int3 size = t.voxels().size();
-        b = {Vec3f::Zero(), Vec3f(float(size.x), float(size.y), float(size.z)) * t.voxelSize()};
-      }
-      centre = pose.pointToWorld(b.center());
-      half = (R * b.halfExtent()).cast<double>();
-    } else {
-      centre = pose.translation;
-      half = (R * bodies_.shape[i].primitive.localHalfExtents()).cast<double>();
-    }
-    // How far any point of the body can move per second: its speed plus its spin times its
-    // radius about the centre of mass (a spinning capsule's ends outrun its centre).
-    const double radius = (centre - bodies_.position[i]).norm() + half.norm();
-    reach_[i] = float(double(bodies_.linearVelocity[i].norm()) + double(bodies_.angularVelocity[i].norm()) * radius);
-    // A margin of how far the body can move this frame keeps fast bodies in their pairs.
-    const double margin = tuning::kBroadphaseMargin + double(reach_[i]) * scene_.settings.timestep;
-    bounds_[i] = {centre - half - Vec3d::Constant(margin), centre + half + Vec3d::Constant(margin)};
+    bounds_[i] = boundsOf(i, reach_[i]);
     isStatic_[i] = bodies_.motion[i] == MotionType::Static;
   }
 }

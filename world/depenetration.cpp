@@ -215,4 +215,10 @@ void World::finishDepenetration() {
   depenetrating_.resize(kept);
 }
 
+const Depenetration* World::depenetration(uint32_t body) const {
+  for (const Depenetration& d : depenetrating_)
+    if (d.body == body) return &d;
+  return nullptr;
+}
+
 }  // namespace bw

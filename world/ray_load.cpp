@@ -10,6 +10,21 @@
 
 namespace bw {
 
+LoadRay RayLoad::makeRay(const RayLoadDescription& load, uint32_t frame, uint32_t k, const Vec3d& lo, const Vec3d& hi) {
+  SeededRandom r((load.seed ^ (uint64_t(frame) * kGoldenGamma)) + k);
+  // note: one draw per statement, so the rays do not depend on the compiler's argument order.
+  Vec3d from, to;
+  for (int a = 0; a < 3; ++a) from[a] = r.uniform(lo[a], hi[a]);
+  for (int a = 0; a < 3; ++a) to[a] = r.uniform(lo[a], hi[a]);
+  LoadRay ray;
+  ray.from = from;
+  const double span = (to - from).norm();
+  if (span == 0) return ray;  // not cast
+  ray.direction = (to - from) / span;
+  ray.length = load.length > 0 ? double(load.length) : (hi - lo).norm();
+  return ray;
+}
+
 RayLoadStats RayLoad::fire(const RayLoadDescription& load, uint32_t frame, const BodyStore& bodies,
                            const std::vector<std::unique_ptr<BrickGrid>>& grids, const std::vector<WorldAabb>& bounds,
                            JobSystem& jobs, Profiler& profiler, int stage) {
@@ -29,22 +44,14 @@ RayLoadStats RayLoad::fire(const RayLoadDescription& load, uint32_t frame, const
   rays_.assign(load.count, LoadRay{});
   hitT_.assign(load.count, std::numeric_limits<float>::infinity());
   stats_.assign(load.count, QueryStats{});
-  const uint64_t seed = load.seed ^ (uint64_t(frame) * kGoldenGamma);
   jobs.parallelFor(0, load.count, tuning::kRayGrain, [&](uint32_t begin, uint32_t end) {
     ProfileZone zone(profiler, "rays", stage);
     for (uint32_t k = begin; k < end; ++k) {
-      SeededRandom r(seed + k);
-      // note: one draw per statement, so the rays do not depend on the compiler's argument order.
-      Vec3d from, to;
-      for (int a = 0; a < 3; ++a) from[a] = r.uniform(lo[a], hi[a]);
-      for (int a = 0; a < 3; ++a) to[a] = r.uniform(lo[a], hi[a]);
-      const double span = (to - from).norm();
-      rays_[k].from = from;
-      if (span == 0) continue;
-      const Vec3d dir = (to - from) / span;
-      const double length = load.length > 0 ? double(load.length) : (hi - lo).norm();
-      rays_[k].direction = dir;
-      rays_[k].length = length;
+      rays_[k] = makeRay(load, frame, k, lo, hi);
+      if (rays_[k].length == 0) continue;
+      const Vec3d& from = rays_[k].from;
+      const Vec3d& dir = rays_[k].direction;
+      const double length = rays_[k].length;
       for (uint32_t body : gridBodies_) {
         const RigidTransform pose = bodies.shapePose(body);
         const Ray ray = Ray::make(pose.pointToLocal(from), pose.directionToLocal(Vec3f(dir.cast<float>())),

@@ -36,6 +36,11 @@ class RayLoad {
   RayLoadStats fire(const RayLoadDescription& load, uint32_t frame, const BodyStore& bodies,
                     const std::vector<std::unique_ptr<BrickGrid>>& grids, const std::vector<WorldAabb>& bounds,
                     JobSystem& jobs, Profiler& profiler, int stage);
+  /// Ray k of frame `frame`: between two seeded random points of the box [lo, hi] (the union of
+  /// the static and kinematic grids' broadphase boxes), looking load.length, or across the box
+  /// when that is 0. The same for every engine given the same box (the Bullet baseline fires
+  /// these too).
+  static LoadRay makeRay(const RayLoadDescription& load, uint32_t frame, uint32_t k, const Vec3d& lo, const Vec3d& hi);
   /// The last frame's rays and each one's closest hit distance along it (infinity: no hit).
   const std::vector<LoadRay>& rays() const { return rays_; }
   const std::vector<float>& hitDistances() const { return hitT_; }

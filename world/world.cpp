@@ -192,6 +192,22 @@ void World::step() {
   ++frame_;
 }
 
+void World::setPoses(const std::vector<Vec3d>& positions, const std::vector<Quatf>& rotations) {
+  const uint32_t n = bodies_.size();
+  if (positions.size() != n || rotations.size() != n)
+    throw InvalidInput("World::setPoses: " + std::to_string(positions.size()) + " positions and " + std::to_string(rotations.size()) +
+                       " rotations for " + std::to_string(n) + " bodies");
+  for (uint32_t i = 0; i < n; ++i) {
+    requireFinite(positions[i], "World::setPoses", "position");
+    requireUnitQuaternion(rotations[i], "World::setPoses", "rotation");
+  }
+  for (uint32_t i = 0; i < n; ++i) {
+    bodies_.position[i] = positions[i];
+    bodies_.rotation[i] = rotations[i].normalized();
+  }
+  pairCache_.forget([](const BodyPair&) { return true; });
+}
+
 uint64_t World::stateHash() const {
   uint64_t h = 0;
   for (uint32_t i = 0; i < bodies_.size(); ++i) {

@@ -115,6 +115,18 @@ class World {
   bool segmentHitsStatic(const Vec3d& from, const Vec3d& to);
   /// The scene's ray load of the last frame: its rays and their closest hits (empty without one).
   const RayLoad& rayLoad() const { return rayLoad_; }
+  /// Body `body`'s broadphase box in its current state (its shape's bounds plus a margin of how
+  /// far it can move in a frame), as the next step computes it. InvalidInput for an unknown body.
+  WorldAabb broadphaseBounds(uint32_t body) const;
+  /// The push-out of a body on its way out of solid (its saved dynamic mass and spawn
+  /// velocity), or nullptr when it is not being pushed out.
+  const Depenetration* depenetration(uint32_t body) const;
+  /// Moves every body to the given centre and rotation (body frame, as bodies().position and
+  /// rotation hold them), velocities kept: to follow another engine's run with this world's
+  /// queries (the Bullet baseline's containment) or to restore saved poses. Cached contacts are
+  /// dropped. Not while step() runs. InvalidInput (nothing moved) when a list's size is not
+  /// the body count or a value is not finite.
+  void setPoses(const std::vector<Vec3d>& positions, const std::vector<Quatf>& rotations);
 
  private:
   // Scene building (scene_build.cpp).
@@ -132,6 +144,7 @@ class World {
   std::string bodySource(uint32_t body) const;
   // Bounds and contacts (contact_generation.cpp, terrain_pairs.cpp).
   void computeBounds();
+  WorldAabb boundsOf(uint32_t body, float& reach) const;
   void generateContacts(float dt);
   void terrainPairs(float dt);
   bool canCollide(uint32_t a, uint32_t b) const;

@@ -8,11 +8,30 @@
 //   OctoBVH        - our OctoBVH over the bodies, every body updated then queried each frame
 //   BruteForce     - all pairs (the floor any method must beat)
 // Counters: pairs per frame, interval/box tests per frame.
+//
+// WorldFrame/<engine>/<scene>: the shipped scene (crates_on_grid, city_rain, lighthouse) for
+// kFrames frames from its initial state on one thread, the same initial state for every engine:
+//   brickworld         - our World (its ray load included)
+//   btCompoundChunked  - Bullet as an expert sets it up (world/bullet_baseline.h): static grids
+//                        as 16 m chunk compounds, CCD, split impulse, the same ray load
+//   btCompoundNaive    - each grid one btCompoundShape of one box per brick, no CCD (the
+//                        article's "compounds" point; not run on city_rain: ~1 s a frame)
+// Counters: median and p95 frame time (ms), contacts per frame; the summary prints the
+// ratios, expert first.
 #include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <string>
 
 #include "collision/core/seeded_random.h"
 #include "collision/index/octobvh.h"
 #include "world/broadphase.h"
+#include "world/bullet_baseline.h"
+#include "world/scene_file.h"
+#include "world/world.h"
 
 namespace {
 
@@ -115,10 +134,81 @@ void Broadphase_BruteForce(benchmark::State& state) {
   state.counters["tests"] = double(state.range(0)) * double(state.range(0) - 1) / 2;
 }
 
-}  // namespace
+
+// ---------------------------------------------------------------- whole frames vs Bullet
+
+constexpr uint32_t kFrames = 240;
+const char* const kScenes[] = {"crates_on_grid", "city_rain", "lighthouse"};
+enum Engine { kBrickworld = 0, kBulletChunked = 1, kBulletNaive = 2 };
+const char* const kEngineNames[] = {"brickworld", "btCompoundChunked", "btCompoundNaive"};
+
+std::map<std::string, double>& medians() {  // "<engine>/<scene>" -> median frame ms
+  static std::map<std::string, double> m;
+  return m;
+}
+
+double quantile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[std::min(v.size() - 1, size_t(q * double(v.size() - 1) + 0.5))];
+}
+
+void WorldFrame(benchmark::State& state, Engine engine, const char* scene) {
+  const SceneDescription description = loadScene(std::string(BW_SOURCE_DIR) + "/profiles/scenes/" + scene + ".json");
+  std::vector<double> frameMs;
+  uint64_t contacts = 0;
+  for (auto _ : state) {
+    World world(description, 1);
+    std::unique_ptr<BulletBaseline> bullet;
+    if (engine != kBrickworld)
+      bullet = std::make_unique<BulletBaseline>(world, engine == kBulletChunked ? BulletSetup::Expert : BulletSetup::Naive);
+    for (uint32_t f = 0; f < kFrames; ++f) {
+      const auto t = std::chrono::steady_clock::now();
+      if (bullet) bullet->step();
+      else world.step();
+      frameMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
+      contacts += bullet ? bullet->lastFrame().contacts : world.lastStats().contacts;
+    }
+  }
+  const double median = quantile(frameMs, 0.5);
+  medians()[std::string(kEngineNames[engine]) + "/" + scene] = median;
+  state.counters["frame_ms_median"] = median;
+  state.counters["frame_ms_p95"] = quantile(frameMs, 0.95);
+  state.counters["contacts_per_frame"] = double(contacts) / double(frameMs.size());
+}
+
+void printWorldRatios() {
+  const auto& m = medians();
+  for (const char* scene : kScenes) {
+    const std::string s = scene;
+    if (!m.count("brickworld/" + s)) continue;
+    const double ours = std::max(m.at("brickworld/" + s), 1e-9);
+    std::printf("%s: brickworld %.3f ms a frame (median)", scene, ours);
+    if (m.count("btCompoundChunked/" + s))
+      std::printf("; Bullet as an expert sets it up %.3f ms (%.1fx)", m.at("btCompoundChunked/" + s), m.at("btCompoundChunked/" + s) / ours);
+    if (m.count("btCompoundNaive/" + s))
+      std::printf("; naive single compound %.3f ms (%.1fx)", m.at("btCompoundNaive/" + s), m.at("btCompoundNaive/" + s) / ours);
+    std::printf("\n");
+  }
+}
 
 BENCHMARK(Broadphase_SweepAndPrune)->Arg(1000)->Arg(2000)->Arg(5000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(Broadphase_OctoBVH)->Arg(1000)->Arg(2000)->Arg(5000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(Broadphase_BruteForce)->Arg(1000)->Arg(2000)->Arg(5000)->Unit(benchmark::kMicrosecond);
 
-BENCHMARK_MAIN();
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (const char* scene : kScenes)
+    for (Engine e : {kBrickworld, kBulletChunked, kBulletNaive}) {
+      if (e == kBulletNaive && std::string(scene) == "city_rain") continue;
+      benchmark::RegisterBenchmark((std::string("WorldFrame/") + kEngineNames[e] + "/" + scene).c_str(), WorldFrame, e, scene)
+          ->Iterations(1)
+          ->Unit(benchmark::kMillisecond);
+    }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  printWorldRatios();
+  return 0;
+}

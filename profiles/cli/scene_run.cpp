@@ -46,38 +46,101 @@ std::string resolveScenePath(const std::string& scene) {
   throw SceneError(scene + ": no such scene file, and no shipped scene of that name in " + BW_SOURCE_DIR + "/profiles/scenes");
 }
 
-// The same scene in Bullet (btDiscreteDynamicsWorld, grids as btCompoundShape), from the World's
-// initial state. Returns the median frame time.
-double runBullet(const World& initial, uint32_t frames, bool json, nlohmann::json& out) {
+// Deepest penetration among the last substep's contacts (m; 0 without any).
+float deepestContact(const World& world) {
+  float deepest = 0;
+  for (uint32_t k = 0; k < world.pairs().size(); ++k)
+    for (const Contact& c : world.pairContacts(k)) deepest = std::max(deepest, c.depth);
+  return deepest;
+}
+
+// The first bodies of a containment report with where they are and why.
+nlohmann::json insideSolidList(const ContainmentReport& inside, const std::vector<Vec3d>& positions) {
+  nlohmann::json list = nlohmann::json::array();
+  for (uint32_t k = 0; k < inside.count() && k < 20; ++k) {
+    const Vec3d& p = positions[inside.bodies[k]];
+    list.push_back({{"body", inside.bodies[k]}, {"why", insideSolidName(inside.reasons[k])}, {"position", {p.x(), p.y(), p.z()}}});
+  }
+  return list;
+}
+
+// The same scene in Bullet from a fresh World's initial state (bullet_baseline.h). The fresh
+// World is also the judge of Bullet's accuracy: it is moved to Bullet's poses after every frame
+// and its containment tracker counts Bullet's bodies inside solid as it counts ours. Returns
+// the median frame time.
+double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, float chunkSize, uint32_t frames, bool json,
+                 nlohmann::json& out) {
   using Clock = std::chrono::steady_clock;
-  BulletBaseline bullet(initial);
+  World judge(scene, threads);
+  BulletBaseline bullet(judge, setup, chunkSize);
+  ContainmentTracker containment(judge);
+  std::vector<Vec3d> positions;
+  std::vector<Quatf> rotations;
   Series total;
-  uint64_t contacts = 0;
+  uint64_t contacts = 0, rays = 0, rayHits = 0;
+  float deepest = 0, endDeepest = 0;
+  const char* label = setup == BulletSetup::Expert ? "bullet" : "bullet-naive";
   for (uint32_t f = 0; f < frames; ++f) {
     const auto t = Clock::now();
     bullet.step();
     total.v.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
-    contacts += bullet.contactCount();
+    const BulletFrame figures = bullet.lastFrame();
+    contacts += figures.contacts;
+    rays += figures.rays;
+    rayHits += figures.rayHits;
+    endDeepest = figures.deepest;
+    deepest = std::max(deepest, figures.deepest);
+    bullet.poses(positions, rotations);
+    judge.setPoses(positions, rotations);
+    containment.update();
     if (!json && frames >= 100 && (f + 1) % (frames / 10) == 0)
-      std::fprintf(stderr, "  bullet frame %u/%u  %.2f ms\n", f + 1, frames, total.v.back());
+      std::fprintf(stderr, "  %s frame %u/%u  %.2f ms\n", label, f + 1, frames, total.v.back());
   }
   uint32_t resting, moving;
   double lowest;
   bullet.restingReport(resting, moving, lowest);
-  out = {{"build_ms", bullet.buildSeconds() * 1e3},
+  const ContainmentReport& inside = containment.report();
+  const std::string how = setup == BulletSetup::Expert
+                              ? "static grids as " + std::to_string(int(chunkSize)) + " m chunk compounds, CCD, split impulse"
+                              : "each grid one btCompoundShape of one box per brick, no CCD";
+  out = {{"engine", label},
+         {"setup", how},
+         {"chunk_objects", bullet.chunkObjects()},
+         {"distinct_brick_shapes", bullet.distinctBrickShapes()},
+         {"build_ms", bullet.buildSeconds() * 1e3},
          {"frame", {{"median_ms", total.quantile(0.5)}, {"p95_ms", total.quantile(0.95)}, {"max_ms", total.max()}}},
          {"contacts_per_frame", double(contacts) / frames},
          {"dynamic_resting", resting},
          {"dynamic_moving", moving},
-         {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0}};
+         {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
+         {"bodies_inside_solid", inside.count()},
+         {"max_penetration_m", deepest},
+         {"end_penetration_m", endDeepest}};
+  if (setup == BulletSetup::Expert) out["chunk_m"] = chunkSize;
+  if (inside.count()) out["inside_solid"] = insideSolidList(inside, positions);
+  if (rays) {
+    out["rays_per_frame"] = double(rays) / frames;
+    out["ray_hit_share"] = double(rayHits) / double(rays);
+  }
   if (!json) {
-    std::printf("bullet baseline (btDiscreteDynamicsWorld, grids as btCompoundShape): compounds built in %.0f ms\n",
-                bullet.buildSeconds() * 1e3);
+    std::printf("%s (btDiscreteDynamicsWorld, %s): built in %.0f ms\n", label, how.c_str(), bullet.buildSeconds() * 1e3);
     std::printf("  frame       %7.3f ms %7.3f ms %7.3f ms   (median, p95, max)\n", total.quantile(0.5), total.quantile(0.95), total.max());
-    std::printf("  per frame: %.0f contacts; dynamic bodies at the end: %u resting, %u moving, lowest at z = %.2f\n",
-                double(contacts) / frames, resting, moving, std::isfinite(lowest) ? lowest : 0.0);
+    std::printf("  per frame: %.0f contacts", double(contacts) / frames);
+    if (rays) std::printf(", %.0f rays (%.1f%% hit)", double(rays) / frames, 100.0 * double(rayHits) / double(rays));
+    std::printf("\n  dynamic bodies at the end: %u resting, %u moving, lowest at z = %.2f\n", resting, moving,
+                std::isfinite(lowest) ? lowest : 0.0);
+    std::printf("  bodies inside solid at the end: %u; deepest contact %.1f mm over the run, %.1f mm in the last frame\n",
+                inside.count(), deepest * 1e3, endDeepest * 1e3);
   }
   return total.quantile(0.5);
+}
+
+// The Bullet setups an --engine value asks for.
+std::vector<BulletSetup> bulletSetups(const std::string& engine) {
+  if (engine == "bullet" || engine == "both") return {BulletSetup::Expert};
+  if (engine == "bullet-naive") return {BulletSetup::Naive};
+  if (engine == "all") return {BulletSetup::Expert, BulletSetup::Naive};
+  return {};
 }
 
 int runScene(const SceneRunOptions& o) {
@@ -85,14 +148,16 @@ int runScene(const SceneRunOptions& o) {
   const std::string path = resolveScenePath(o.scene);
   SceneDescription scene = loadScene(path);
   if (!o.sleeping.empty()) scene.settings.sleeping = o.sleeping == "on";
-  if (o.engine != "brickworld" && o.engine != "bullet" && o.engine != "both")
-    throw std::invalid_argument("--engine must be brickworld, bullet or both (got '" + o.engine + "')");
+  const std::vector<BulletSetup> setups = bulletSetups(o.engine);
+  if (o.engine != "brickworld" && setups.empty())
+    throw std::invalid_argument("--engine must be brickworld, bullet, bullet-naive, both or all (got '" + o.engine + "')");
+  if (!setups.empty()) BulletBaseline::requireMirrorable(scene);  // refuse before running ours
   const auto tBuild = Clock::now();
   World world(scene, o.threads);
-  if (o.engine == "bullet") {
+  if (o.engine == "bullet" || o.engine == "bullet-naive") {
     nlohmann::json b;
-    runBullet(world, o.frames ? o.frames : scene.settings.frames, o.json, b);
-    if (o.json) std::cout << nlohmann::json{{"scene", scene.name}, {"engine", "bullet"}, {"bullet", b}}.dump(2) << "\n";
+    runBullet(scene, o.threads, setups[0], o.bulletChunk, o.frames ? o.frames : scene.settings.frames, o.json, b);
+    if (o.json) std::cout << nlohmann::json{{"scene", scene.name}, {"engine", o.engine}, {"bullet", b}}.dump(2) << "\n";
     return 0;
   }
   const double buildMs = std::chrono::duration<double, std::milli>(Clock::now() - tBuild).count();
@@ -109,6 +174,7 @@ int runScene(const SceneRunOptions& o) {
            "bodies_inside_solid\n";
   }
   double work = 0, span = 0;
+  float deepest = 0, endDeepest = 0;  // deepest contact over the run and in the last frame
   std::vector<Vec3d> settled;  // positions at --drift-after
   ContainmentTracker containment(world);  // updated after each step, outside its timing
   const auto tRun = Clock::now();
@@ -117,6 +183,8 @@ int runScene(const SceneRunOptions& o) {
     world.step();
     const StepStats& s = world.lastStats();
     containment.update();
+    endDeepest = deepestContact(world);
+    deepest = std::max(deepest, endDeepest);
     total.v.push_back(s.totalMs);
     broad.v.push_back(s.broadphaseMs);
     contacts.v.push_back(s.contactsMs);
@@ -190,15 +258,12 @@ int runScene(const SceneRunOptions& o) {
                      {"dynamic_moving", moving},
                      {"lowest_dynamic_z", std::isfinite(lowest) ? lowest : 0.0},
                      {"bodies_inside_solid", inside.count()},
+                     {"max_penetration_m", deepest},
+                     {"end_penetration_m", endDeepest},
                      {"bodies_started_in_solid", world.startedInSolid()},
                      {"bodies_being_pushed_out", world.depenetratingCount()},
                      {"state_hash", world.stateHash()}};
-    if (inside.count()) {
-      nlohmann::json list = nlohmann::json::array();
-      for (uint32_t k = 0; k < inside.count() && k < 20; ++k)
-        list.push_back({{"body", inside.bodies[k]}, {"why", insideSolidName(inside.reasons[k])}, {"position", {bodies.position[inside.bodies[k]].x(), bodies.position[inside.bodies[k]].y(), bodies.position[inside.bodies[k]].z()}}});
-      j["inside_solid"] = list;
-    }
+    if (inside.count()) j["inside_solid"] = insideSolidList(inside, bodies.position);
     if (!settled.empty()) j["drift_after_frame"] = {{"frame", o.driftAfter}, {"max_displacement_m", drift}};
     if (!scene.terrains.empty()) {
       j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
@@ -210,12 +275,12 @@ int runScene(const SceneRunOptions& o) {
       j["ray_hit_share"] = double(rayHits) / double(rayCount);
       j["ray_box_tests_per_ray"] = double(rayBoxTests) / double(rayCount);
     }
-    if (o.engine == "both") {
+    for (BulletSetup setup : setups) {
       nlohmann::json b;
-      World fresh(scene, o.threads);
-      const double bulletMedian = runBullet(fresh, frames, true, b);
-      j["bullet"] = b;
-      j["bullet_over_brickworld_median"] = bulletMedian / std::max(total.quantile(0.5), 1e-9);
+      const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, frames, true, b);
+      const std::string key = setup == BulletSetup::Expert ? "bullet" : "bullet_naive";
+      j[key] = b;
+      j[key + "_over_brickworld_median"] = bulletMedian / std::max(total.quantile(0.5), 1e-9);
     }
     std::cout << j.dump(2) << "\n";
     return 0;
@@ -241,6 +306,7 @@ int runScene(const SceneRunOptions& o) {
               world.sleepingCount(), moving, std::isfinite(lowest) ? lowest : 0.0);
   std::printf("  bodies inside solid at the end: %u (%u started inside solid and were pushed out, %u still on their way)\n",
               inside.count(), world.startedInSolid(), world.depenetratingCount());
+  std::printf("  deepest contact %.1f mm over the run, %.1f mm in the last frame\n", deepest * 1e3, endDeepest * 1e3);
   for (uint32_t k = 0; k < inside.count() && k < 5; ++k) {
     const Vec3d& p = bodies.position[inside.bodies[k]];
     std::printf("    body %u at (%.2f, %.2f, %.2f): %s\n", inside.bodies[k], p.x(), p.y(), p.z(), insideSolidName(inside.reasons[k]));
@@ -251,11 +317,11 @@ int runScene(const SceneRunOptions& o) {
   std::printf("  work %.1f ms, span %.1f ms over the run\n", work, span);
   if (!o.csvPath.empty()) std::printf("  per-frame CSV: %s\n", o.csvPath.c_str());
   if (!o.tracePath.empty()) std::printf("  Chrome trace: %s (open in Perfetto)\n", o.tracePath.c_str());
-  if (o.engine == "both") {
+  for (BulletSetup setup : setups) {
     nlohmann::json b;
-    World fresh(scene, o.threads);
-    const double bulletMedian = runBullet(fresh, frames, false, b);
-    std::printf("bullet / brickworld median frame time: %.1fx\n", bulletMedian / std::max(total.quantile(0.5), 1e-9));
+    const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, frames, false, b);
+    std::printf("%s / brickworld median frame time: %.1fx\n", setup == BulletSetup::Expert ? "bullet" : "bullet-naive",
+                bulletMedian / std::max(total.quantile(0.5), 1e-9));
   }
   return 0;
 }

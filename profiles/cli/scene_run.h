@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <string>
 
+#include "world/bullet_baseline.h"
+
 namespace bw::cli {
 
 struct SceneRunOptions {
@@ -14,7 +16,10 @@ struct SceneRunOptions {
   std::string tracePath;    ///< Chrome trace of the whole run
   bool json = false;
   bool progress = true;
-  std::string engine = "brickworld";  ///< brickworld, bullet, or both (same initial state, ratio printed)
+  /// brickworld; bullet (Bullet as an expert sets it up) or bullet-naive (one compound per grid);
+  /// both (brickworld and bullet) or all (the three): same initial state, ratios printed.
+  std::string engine = "brickworld";
+  float bulletChunk = BulletBaseline::kDefaultChunkSize;  ///< edge of the expert Bullet setup's chunk compounds (m)
   std::string sleeping;     ///< "on"/"off" overrides the scene's setting; empty keeps it
 };
 
