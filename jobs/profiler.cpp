@@ -76,17 +76,19 @@ double WorkSpan::speedupBound(int threads) const {
   return b > 0 ? workMs / b : 1.0;
 }
 
-WorkSpan Profiler::workSpan(uint32_t frame) const {
-  std::map<int32_t, std::pair<double, double>> stages;  // stage -> (work, longest job)
-  for (const ProfileEvent& e : events()) {
-    if (e.frame != frame || e.stage < 0) continue;
-    const double ms = double(e.endNs - e.beginNs) * 1e-6;
-    auto& s = stages[e.stage];
-    s.first += ms;
-    s.second = std::max(s.second, ms);
-  }
+namespace {
+using StageTimes = std::map<int32_t, std::pair<double, double>>;  // stage -> (work, longest job)
+
+void addZone(StageTimes& stages, const ProfileEvent& e) {
+  const double ms = double(e.endNs - e.beginNs) * 1e-6;
+  auto& s = stages[e.stage];
+  s.first += ms;
+  s.second = std::max(s.second, ms);
+}
+
+WorkSpan toWorkSpan(const StageTimes& stages) {
   WorkSpan ws;
-  for (auto& [stage, s] : stages) {
+  for (const auto& [stage, s] : stages) {
     ws.workMs += s.first;
     ws.spanMs += s.second;
     ws.stageWorkMs.push_back(s.first);
@@ -94,6 +96,30 @@ WorkSpan Profiler::workSpan(uint32_t frame) const {
   }
   ws.stages = int(stages.size());
   return ws;
+}
+}  // namespace
+
+std::vector<WorkSpan> Profiler::workSpans(uint32_t frames) const {
+  std::vector<StageTimes> perFrame(frames);
+  {
+    std::lock_guard<std::mutex> lock(registry_);
+    for (const auto& b : buffers_)
+      for (const ProfileEvent& e : b->events)
+        if (e.frame < frames && e.stage >= 0) addZone(perFrame[e.frame], e);
+  }
+  std::vector<WorkSpan> out;
+  out.reserve(frames);
+  for (const StageTimes& stages : perFrame) out.push_back(toWorkSpan(stages));
+  return out;
+}
+
+WorkSpan Profiler::workSpan(uint32_t frame) const {
+  StageTimes stages;
+  std::lock_guard<std::mutex> lock(registry_);
+  for (const auto& b : buffers_)
+    for (const ProfileEvent& e : b->events)
+      if (e.frame == frame && e.stage >= 0) addZone(stages, e);
+  return toWorkSpan(stages);
 }
 
 void Profiler::writeChromeTrace(const std::string& path) const {

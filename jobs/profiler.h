@@ -72,6 +72,9 @@ class Profiler {
   std::vector<ProfileEvent> events() const;
   /// Work/span of one frame's job zones.
   WorkSpan workSpan(uint32_t frame) const;
+  /// Work/span of frames 0 .. frames-1 in one pass over the events (workSpan per frame would
+  /// read every event once per frame).
+  std::vector<WorkSpan> workSpans(uint32_t frames) const;
   /// Writes every event as Chrome trace JSON ("X" complete events, microseconds). Throws
   /// std::runtime_error naming the path if the file cannot be written.
   void writeChromeTrace(const std::string& path) const;

@@ -14,11 +14,14 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
     throw InvalidInput("SweepAndPrune::update: " + std::to_string(bounds.size()) + " bounds but " +
                        std::to_string(isStatic.size()) + " static flags");
   for (uint32_t i = 0; i < n; ++i) {
+    // Checked without building a message per body (this runs every substep); the message is
+    // made only for the body that fails.
+    const WorldAabb& b = bounds[i];
+    if (b.min.allFinite() && b.max.allFinite() && (b.min.array() <= b.max.array()).all()) continue;
     const std::string what = "bounds of body " + std::to_string(i);
-    requireFinite(bounds[i].min, "SweepAndPrune::update", (what + " min").c_str());
-    requireFinite(bounds[i].max, "SweepAndPrune::update", (what + " max").c_str());
-    if ((bounds[i].min.array() > bounds[i].max.array()).any())
-      throw InvalidInput("SweepAndPrune::update: " + what + " are inverted (min > max)");
+    requireFinite(b.min, "SweepAndPrune::update", (what + " min").c_str());
+    requireFinite(b.max, "SweepAndPrune::update", (what + " max").c_str());
+    throw InvalidInput("SweepAndPrune::update: " + what + " are inverted (min > max)");
   }
   // Sweep along the axis where the body centres spread most (fewest overlapping intervals).
   Vec3d mean = Vec3d::Zero(), sq = Vec3d::Zero();

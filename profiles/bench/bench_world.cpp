@@ -10,7 +10,8 @@
 // Counters: pairs per frame, interval/box tests per frame.
 //
 // WorldFrame/<engine>/<scene>: the shipped scene (crates_on_grid, city_rain, lighthouse) for
-// kFrames frames from its initial state on one thread, the same initial state for every engine:
+// its own frame count (300: landing and rest) on one thread, from the same initial state for
+// every engine:
 //   brickworld         - our World (its ray load included)
 //   btCompoundChunked  - Bullet as an expert sets it up (world/bullet_baseline.h): static grids
 //                        as 16 m chunk compounds, CCD, split impulse, the same ray load
@@ -137,7 +138,6 @@ void Broadphase_BruteForce(benchmark::State& state) {
 
 // ---------------------------------------------------------------- whole frames vs Bullet
 
-constexpr uint32_t kFrames = 240;
 const char* const kScenes[] = {"crates_on_grid", "city_rain", "lighthouse"};
 enum Engine { kBrickworld = 0, kBulletChunked = 1, kBulletNaive = 2 };
 const char* const kEngineNames[] = {"brickworld", "btCompoundChunked", "btCompoundNaive"};
@@ -161,7 +161,7 @@ void WorldFrame(benchmark::State& state, Engine engine, const char* scene) {
     std::unique_ptr<BulletBaseline> bullet;
     if (engine != kBrickworld)
       bullet = std::make_unique<BulletBaseline>(world, engine == kBulletChunked ? BulletSetup::Expert : BulletSetup::Naive);
-    for (uint32_t f = 0; f < kFrames; ++f) {
+    for (uint32_t f = 0; f < description.settings.frames; ++f) {
       const auto t = std::chrono::steady_clock::now();
       if (bullet) bullet->step();
       else world.step();

@@ -210,8 +210,7 @@ int runScene(const SceneRunOptions& o) {
   }
   const double runS = std::chrono::duration<double>(Clock::now() - tRun).count();
   // Work and span over the whole run (stages are sequential, each stage's work in one zone here).
-  for (uint32_t f = 0; f < frames; ++f) {
-    const WorkSpan ws = world.profiler().workSpan(f);
+  for (const WorkSpan& ws : world.profiler().workSpans(frames)) {
     work += ws.workMs;
     span += ws.spanMs;
   }

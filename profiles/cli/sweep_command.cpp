@@ -38,8 +38,7 @@ SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames) {
   r.medianMs = t[t.size() / 2];
   r.p95Ms = t[std::min(t.size() - 1, size_t(double(t.size()) * 0.95))];
   // Sum the per-frame bounds: the run's time with p threads is at least the sum over frames.
-  for (uint32_t f = 0; f < frames; ++f) {
-    const WorkSpan ws = world.profiler().workSpan(f);
+  for (const WorkSpan& ws : world.profiler().workSpans(frames)) {
     r.workMs += ws.workMs;
     r.spanMs += ws.spanMs;
     if (r.perFrame.stageWorkMs.size() < ws.stageWorkMs.size()) {
