@@ -24,7 +24,7 @@ struct SubmissionSample {
   double frameMs = 0;           ///< mean wall time per frame including waits for the render thread
   double commandsPerFrame = 0;  ///< render commands executed per frame (fences included)
   double updatesPerFrame = 0;   ///< primitive + light updates applied per frame (same in every mode)
-  double radiusPerFrame = 0;    ///< light radius refreshes per frame (per-object only)
+  double radiusPerFrame = 0;    ///< light radius refreshes per frame (PerObjectMutex/Concurrent only)
 };
 
 /// One transform-update layout measurement.

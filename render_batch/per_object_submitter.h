@@ -3,7 +3,9 @@
 /// inside the parallel transform update (the worker that computed it pushes it).
 ///
 /// Models the engine of article 000: a light move also enqueues a radius refresh, so a frame
-/// costs primitives + 2 x lights commands (plus the frame fence).
+/// costs primitives + 2 x lights commands (plus the frame fence). Without the refresh
+/// (sendLightRadius false, the `NoRadius` modes) it is primitives + lights, like for like with
+/// batched submission.
 #include "render_batch/render_thread.h"
 #include "transforms/transform_update_sink.h"
 

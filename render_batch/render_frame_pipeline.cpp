@@ -9,10 +9,11 @@ namespace bw {
 namespace {
 
 std::unique_ptr<CommandQueue> makeQueue(SubmissionMode mode, const AttachmentStore& store) {
-  if (mode == SubmissionMode::PerObjectConcurrent) return std::make_unique<ConcurrentCommandQueue>();
+  if (usesConcurrentQueue(mode)) return std::make_unique<ConcurrentCommandQueue>();
   // note: the per-object mutex queue is reserved for a full frame of commands so that the
   // comparison measures locking, not vector growth.
-  const size_t expected = mode == SubmissionMode::PerObjectMutex ? store.primitiveCount() + 2u * store.lightCount() + 1 : 4;
+  const size_t perLight = sendsLightRadius(mode) ? 2u : 1u;
+  const size_t expected = mode == SubmissionMode::Batched ? 4 : store.primitiveCount() + perLight * store.lightCount() + 1;
   return std::make_unique<MutexCommandQueue>(expected);
 }
 
@@ -33,7 +34,7 @@ RenderFramePipeline::RenderFramePipeline(AttachmentStore& store, SubmissionMode 
         *render_, batchPrimitiveCapacity == UINT32_MAX ? store.primitiveCount() : batchPrimitiveCapacity,
         batchLightCapacity == UINT32_MAX ? store.lightCount() : batchLightCapacity);
   else
-    perObject_ = std::make_unique<PerObjectSubmitter>(*render_);
+    perObject_ = std::make_unique<PerObjectSubmitter>(*render_, sendsLightRadius(mode));
 }
 
 RenderFramePipeline::~RenderFramePipeline() {

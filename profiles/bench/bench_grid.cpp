@@ -1,14 +1,56 @@
-// bench_grid: brick grids vs Bullet's btCompoundShape of the same bricks.
+// bench_grid: brick grids vs Bullet 3.24 on the same bricks, Bullet set up as its experts would
+// (chunk compounds of shared exact shapes in a persistent world) and, as a labelled second row,
+// naively (one compound of every brick).
 //
 //   build/release/bin/bench_grid --benchmark_counters_tabular=true
 //
-// GridContact/<shape>/<bricks>/lod:<0|1>: a 0.5 m box (0), a capsule (1) or an 8 m box (2) resting on a city-block grid
-//   (poses found by raycasting onto its surface), time per contact query, contacts, narrowphase
-//   calls, box tests, and with LOD the depth error against LOD off.
+// Query shapes <shape>: 0 = a 0.5 m box, 1 = a capsule (radius 0.25, core 0.5 along z, 1 m
+// tall), 2 = an 8 m box, resting on a city-block grid (poses found by raycasting onto its
+// surface, random yaw; the same 1024 poses for our rows and the Bullet rows of a shape).
+//
+// GridContact/<shape>/<bricks>/<lod 0|1>: our grid (exact brick shapes): time per contact query,
+//   contacts (after reduction to 4), raw contacts, narrowphase calls, box tests, and with LOD
+//   the depth error against LOD off.
 // GridEdit/<bricks>: place + remove one brick including index and mass properties.
+// GridBuild/<bricks>: build time and bytes per brick.
 // ConvexApprox/<build>/<depth>: hull build time, hull volume / brick volume, box or not.
-// btCompound/<bricks>: the same bricks as a btCompoundShape: build time, bytes per brick,
-//   contactPairTest time for the same poses. The summary prints the ratios.
+// btCompoundChunked/<shape>/<bricks>/<chunk_m>: Bullet as an expert sets it up: the grid cut
+//   into chunk_m cubes by buildBulletChunks (one shared btBoxShape / btCylinderShapeZ /
+//   btConvexHullShape per distinct brick, exact rotations), each chunk's compound tree rebuilt
+//   with optimizeTopDown(), one static btCollisionObject per chunk compound in a persistent
+//   btCollisionWorld (btDbvtBroadphase, optimised once after adding), queried with
+//   btCollisionWorld::contactTest of a query object of the same shape. Chunk sizes 2..32 m at
+//   100k bricks, 8 m at 10k. 8 m is the comparison's chunk size: in the sweep (2026-11-23) 2..16 m
+//   were within a few percent of each other for the 0.5 m box and the capsule, 4 m was 4-14%
+//   faster than 8 m for the 8 m box and 32 m was slowest for all three; the summary also prints
+//   the sweep's fastest size beside 8 m. Counters: contacts (every point Bullet
+//   reports: box-box manifolds, and for GJK pairs gaps up to both margins + the breaking
+//   threshold too), contacts_pen (points with distance < 0), us_per_query, bytes_per_element (child
+//   records, compound trees, chunk objects and broadphase nodes, shared shapes; per brick),
+//   chunks, chunks_per_query (broadphase hits of the query's AABB), build_ms; accuracy beside
+//   speed, untimed over the same poses: depth_diff_max / depth_diff_mean (Bullet's deepest
+//   penetration vs ours, LOD off) and only_bullet / only_ours (poses where one side alone finds
+//   a penetration).
+// btCompoundTree/<shape>/<bricks>: Bullet's fastest direct path a user could write on the same
+//   8 m chunks: chunks whose AABB overlaps the query's (a btDbvt of chunk AABBs, optimised),
+//   then btDbvt::collideTV of the query's AABB (in the chunk's frame) against the chunk
+//   compound's own getDynamicAabbTree(), then per overlapping child btBoxBoxDetector for box vs
+//   box children (up to 4 points per pair, what contactTest's per-child box-box algorithm runs)
+//   and btGjkPairDetector (GJK + EPA, what the dispatcher's convex-convex algorithm runs, with its
+//   distance cut: both margins + the manifold's breaking threshold) for every other pair. No
+//   per-query allocation once warm.
+//   Counters: contacts, contacts_pen, narrowphase (children tested), chunks_per_query.
+// btCompoundNaive/<bricks>: the naive setup, kept as a labelled second baseline: one
+//   btCompoundShape of every brick (a btBoxShape of each brick's bounds), contactPairTest of the
+//   0.5 m box, which builds a compound algorithm (O(bricks) bookkeeping) per query.
+// The summary prints our grid (LOD off) against btCompoundChunked at 8 m, the best chunk size of
+// the sweep, btCompoundTree and the naive row, per shape.
+#include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
+#include <BulletCollision/CollisionDispatch/btBoxBoxDetector.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
+#include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
+#include <algorithm>
 #include <benchmark/benchmark.h>
 #include <btBulletCollisionCommon.h>
 #include <chrono>
@@ -17,6 +59,7 @@
 #include <memory>
 
 #include "collision/bricks/brick_grid.h"
+#include "collision/bricks/bullet_brick_shapes.h"
 #include "collision/content/build_generators.h"
 #include "collision/core/seeded_random.h"
 
@@ -155,7 +198,11 @@ void ConvexApprox(benchmark::State& state) {
   state.counters["is_box"] = a.isBox ? 1 : 0;
 }
 
-// ---------------------------------------------------------------- Bullet compound baseline
+// ---------------------------------------------------------------- Bullet: naive compound (second baseline)
+
+// The naive setup: one btCompoundShape of every brick, each a btBoxShape of the brick's bounds.
+// Kept beside the expert rows below, labelled naive: contactPairTest builds a compound algorithm
+// per query, whose bookkeeping is O(children) before the tree is walked.
 
 struct CompoundBuild {
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
@@ -194,7 +241,7 @@ struct CountContacts : btCollisionWorld::ContactResultCallback {
   }
 };
 
-void btCompound(benchmark::State& state) {
+void btCompoundNaive(benchmark::State& state) {
   const uint32_t bricks = uint32_t(state.range(0));
   CompoundBuild& c = compound(bricks);
   const auto poses = restingPoses(grid(bricks), 0.25f, 256, 3);
@@ -220,7 +267,260 @@ void btCompound(benchmark::State& state) {
   state.counters["contacts"] = double(cb.n) / double(state.iterations());
   state.counters["build_ms"] = c.buildSeconds * 1e3;
   state.counters["bytes_per_brick"] = c.bytesPerBrick;
-  state.counters["bricks"] = double(bricks);
+  state.counters["bricks"] = double(city(bricks).bricks.size());
+}
+
+// ---------------------------------------------------------------- Bullet as an expert sets it up
+
+// Chunk edge (m) of the comparison and of btCompoundTree (the 100k sweep: see the header).
+constexpr int kChosenChunkM = 8;
+
+btTransform toBullet(const RigidTransform& p) {
+  return btTransform(btQuaternion(p.rotation.x(), p.rotation.y(), p.rotation.z(), p.rotation.w()),
+                     btVector3(btScalar(p.translation.x()), btScalar(p.translation.y()), btScalar(p.translation.z())));
+}
+
+// The query shapes of shapeNamed() in Bullet. Both keep their margin inside the shape (a box's
+// inside its half extents, a capsule's is its radius), so they are exact.
+std::unique_ptr<btConvexShape> bulletQueryShape(int kind) {
+  if (kind == 1) return std::make_unique<btCapsuleShapeZ>(0.25f, 0.5f);  // radius, core length (2 x halfHeight)
+  const float h = kind == 2 ? 4.f : 0.25f;
+  return std::make_unique<btBoxShape>(btVector3(h, h, h));
+}
+
+// A grid as chunk compounds in a persistent world, plus a btDbvt of the chunks' world AABBs for
+// the direct path (leaf data = chunk index). The grid pose is identity, as in GridContact, so a
+// chunk object sits at gridPose * chunk origin = its origin.
+struct ChunkedWorld {
+  BulletBrickShapes shapes;
+  std::vector<BulletBrickChunk> chunks;
+  std::vector<std::unique_ptr<btCollisionObject>> objects;
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+  btDbvtBroadphase broadphase;
+  btCollisionWorld world{&dispatcher, &broadphase, &config};  // note: destroyed before the objects it holds
+  btDbvt chunkTree;
+  double buildSeconds = 0;
+  double bytesPerBrick = 0;
+};
+
+ChunkedWorld& chunkedWorld(uint32_t bricks, int chunkM) {
+  static std::map<std::pair<uint32_t, int>, std::unique_ptr<ChunkedWorld>> cache;
+  auto& w = cache[{bricks, chunkM}];
+  if (!w) {
+    w = std::make_unique<ChunkedWorld>();
+    const BrickGrid& g = grid(bricks);
+    const RigidTransform gridPose{};
+    const auto t = Clock::now();
+    w->chunks = buildBulletChunks(g, float(chunkM), w->shapes);
+    for (size_t i = 0; i < w->chunks.size(); ++i) {
+      const BulletBrickChunk& c = w->chunks[i];
+      // note: a static chunk's own tree is built by incremental inserts; rebuild it top-down once,
+      // as a user would. Leaves (and so each child's m_node) survive the rebuild.
+      c.shape->getDynamicAabbTree()->optimizeTopDown();
+      auto o = std::make_unique<btCollisionObject>();
+      o->setCollisionShape(c.shape.get());
+      o->setWorldTransform(toBullet(gridPose) * btTransform(btQuaternion::getIdentity(), btVector3(c.origin.x(), c.origin.y(), c.origin.z())));
+      o->setCollisionFlags(o->getCollisionFlags() | btCollisionObject::CF_STATIC_OBJECT);
+      w->world.addCollisionObject(o.get(), int(btBroadphaseProxy::StaticFilter),
+                                  int(btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter));
+      btVector3 mn, mx;
+      c.shape->getAabb(o->getWorldTransform(), mn, mx);
+      w->chunkTree.insert(btDbvtVolume::FromMM(mn, mx), reinterpret_cast<void*>(i));
+      w->objects.push_back(std::move(o));
+    }
+    w->broadphase.optimize();    // static chunks: build the broadphase tree top-down once
+    w->chunkTree.optimizeTopDown();
+    w->buildSeconds = std::chrono::duration<double>(Clock::now() - t).count();
+    // Per brick: its child record and two compound-tree nodes; per chunk: the compound, its tree,
+    // its object, its broadphase proxy and two broadphase-tree nodes; the shared shapes once.
+    const size_t perChunk = sizeof(btCompoundShape) + sizeof(btDbvt) + sizeof(btCollisionObject) + sizeof(btDbvtProxy) +
+                            2 * sizeof(btDbvtNode);
+    const size_t total = size_t(g.brickCount()) * kBulletCompoundChildBytes + w->chunks.size() * perChunk + w->shapes.bytes();
+    w->bytesPerBrick = double(total) / double(g.brickCount());
+  }
+  return *w;
+}
+
+// Counts every point Bullet reports and those with a negative distance (penetrating).
+struct ContactCounter : btCollisionWorld::ContactResultCallback {
+  uint64_t all = 0, penetrating = 0;
+  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper*, int, int, const btCollisionObjectWrapper*, int,
+                           int) override {
+    ++all;
+    penetrating += cp.getDistance() < 0;
+    return 0;
+  }
+};
+
+// The deepest penetration among the points Bullet reports (0 when none penetrates).
+struct DeepestPenetration : btCollisionWorld::ContactResultCallback {
+  float deepest = 0;
+  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper*, int, int, const btCollisionObjectWrapper*, int,
+                           int) override {
+    deepest = std::max(deepest, float(-cp.getDistance()));
+    return 0;
+  }
+};
+
+// Counts broadphase proxies whose AABB overlaps (chunks a query reaches).
+struct ProxyCounter : btBroadphaseAabbCallback {
+  uint64_t n = 0;
+  bool process(const btBroadphaseProxy*) override {
+    ++n;
+    return true;
+  }
+};
+
+void btCompoundChunked(benchmark::State& state) {
+  const int kind = int(state.range(0));
+  const uint32_t bricks = uint32_t(state.range(1));
+  const int chunkM = int(state.range(2));
+  ChunkedWorld& w = chunkedWorld(bricks, chunkM);
+  const auto poses = restingPoses(grid(bricks), halfHeightOf(kind), 1024, 3);
+  const std::unique_ptr<btConvexShape> shape = bulletQueryShape(kind);
+  btCollisionObject query;
+  query.setCollisionShape(shape.get());
+  ContactCounter cb;
+  uint64_t q = 0;
+  const auto t0 = Clock::now();
+  for (auto _ : state) {
+    query.setWorldTransform(toBullet(poses[q++ & 1023]));
+    w.world.contactTest(&query, cb);
+  }
+  const double it = double(state.iterations());
+  const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / it;
+  ProxyCounter reached;  // untimed: chunks per query over the 1024 poses
+  for (const RigidTransform& p : poses) {
+    btVector3 mn, mx;
+    shape->getAabb(toBullet(p), mn, mx);
+    w.broadphase.aabbTest(mn, mx, reached);
+  }
+  // Accuracy beside speed (untimed): per pose, Bullet's deepest penetration against our grid's
+  // (LOD off, raw contacts), and the poses where only one side finds a penetration.
+  const BrickGrid& g = grid(bricks);
+  const QueryShape ours = shapeNamed(kind);
+  ContactParams exact;
+  exact.lodFraction = 0.f;
+  std::vector<LocalContact> raw;
+  double diffMax = 0, diffSum = 0;
+  uint32_t onlyBullet = 0, onlyOurs = 0;
+  for (const RigidTransform& p : poses) {
+    DeepestPenetration d;
+    query.setWorldTransform(toBullet(p));
+    w.world.contactTest(&query, d);
+    raw.clear();
+    g.collideLocal(ours, LocalPose{p.translation.cast<float>(), p.rotation}, exact, raw);
+    float deepest = 0;
+    for (const LocalContact& c : raw) deepest = std::max(deepest, c.depth);
+    diffMax = std::max(diffMax, double(std::abs(d.deepest - deepest)));
+    diffSum += std::abs(d.deepest - deepest);
+    onlyBullet += d.deepest > 0 && deepest <= 0;
+    onlyOurs += deepest > 0 && d.deepest <= 0;
+  }
+  summary()["chunked_us_" + std::to_string(kind) + "_" + std::to_string(bricks) + "_" + std::to_string(chunkM)] = us;
+  state.counters["depth_diff_max"] = diffMax;
+  state.counters["depth_diff_mean"] = diffSum / double(poses.size());
+  state.counters["only_bullet"] = onlyBullet;
+  state.counters["only_ours"] = onlyOurs;
+  state.counters["contacts"] = double(cb.all) / it;
+  state.counters["contacts_pen"] = double(cb.penetrating) / it;
+  state.counters["us_per_query"] = us;
+  state.counters["bytes_per_element"] = w.bytesPerBrick;
+  state.counters["chunks"] = double(w.chunks.size());
+  state.counters["chunks_per_query"] = double(reached.n) / double(poses.size());
+  state.counters["build_ms"] = w.buildSeconds * 1e3;
+  state.counters["bricks"] = double(g.brickCount());
+}
+
+// Leaf collector for collideTV: the leaves' data as indices (chunk index or compound child index).
+struct LeafIndices : btDbvt::ICollide {
+  std::vector<int>* out = nullptr;
+  void Process(const btDbvtNode* leaf) override { out->push_back(leaf->dataAsInt); }
+};
+
+// Counts the points a detector reports (Bullet's sign: negative distance = penetration).
+struct PointCounter : btDiscreteCollisionDetectorInterface::Result {
+  uint64_t all = 0, penetrating = 0;
+  void setShapeIdentifiersA(int, int) override {}
+  void setShapeIdentifiersB(int, int) override {}
+  void addContactPoint(const btVector3&, const btVector3&, btScalar depth) override {
+    ++all;
+    penetrating += depth < 0;
+  }
+};
+
+void btCompoundTree(benchmark::State& state) {
+  const int kind = int(state.range(0));
+  const uint32_t bricks = uint32_t(state.range(1));
+  ChunkedWorld& w = chunkedWorld(bricks, kChosenChunkM);
+  const auto poses = restingPoses(grid(bricks), halfHeightOf(kind), 1024, 3);
+  const std::unique_ptr<btConvexShape> shape = bulletQueryShape(kind);
+  const btBoxShape* queryBox = kind == 1 ? nullptr : static_cast<const btBoxShape*>(shape.get());
+  btVoronoiSimplexSolver simplex;
+  btGjkEpaPenetrationDepthSolver epa;
+  std::vector<int> chunkHits, childHits;
+  chunkHits.reserve(1024);
+  childHits.reserve(4096);
+  LeafIndices chunkCollector, childCollector;
+  chunkCollector.out = &chunkHits;
+  childCollector.out = &childHits;
+  PointCounter points;
+  uint64_t q = 0, narrowphase = 0, chunksReached = 0;
+  // The breaking threshold the dispatcher gives a manifold of the query and a chunk (relative to
+  // shape sizes when CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD is on, Bullet's default).
+  const bool relative = (w.dispatcher.getDispatcherFlags() & btCollisionDispatcher::CD_USE_RELATIVE_CONTACT_BREAKING_THRESHOLD) != 0;
+  auto breakingFor = [&](const btCompoundShape& c) {
+    return relative ? std::min(shape->getContactBreakingThreshold(gContactBreakingThreshold),
+                               c.getContactBreakingThreshold(gContactBreakingThreshold))
+                    : gContactBreakingThreshold;
+  };
+  const auto t0 = Clock::now();
+  for (auto _ : state) {
+    const btTransform queryXf = toBullet(poses[q++ & 1023]);
+    btVector3 mn, mx;
+    shape->getAabb(queryXf, mn, mx);
+    chunkHits.clear();
+    w.chunkTree.collideTV(w.chunkTree.m_root, btDbvtVolume::FromMM(mn, mx), chunkCollector);
+    chunksReached += chunkHits.size();
+    for (int ci : chunkHits) {
+      const btCollisionObject& chunkObject = *w.objects[size_t(ci)];
+      const btCompoundShape& compound = *w.chunks[size_t(ci)].shape;
+      const btTransform& chunkXf = chunkObject.getWorldTransform();
+      const btScalar breaking = breakingFor(compound);
+      // The query's AABB in the chunk's frame, as btCompoundCollisionAlgorithm computes it.
+      shape->getAabb(chunkXf.inverseTimes(queryXf), mn, mx);
+      childHits.clear();
+      compound.getDynamicAabbTree()->collideTV(compound.getDynamicAabbTree()->m_root, btDbvtVolume::FromMM(mn, mx), childCollector);
+      narrowphase += childHits.size();
+      for (int child : childHits) {
+        const btCollisionShape* childShape = compound.getChildShape(child);
+        btDiscreteCollisionDetectorInterface::ClosestPointInput input;
+        input.m_transformA = queryXf;
+        input.m_transformB = chunkXf * compound.getChildTransform(child);
+        if (queryBox && childShape->getShapeType() == BOX_SHAPE_PROXYTYPE) {
+          btBoxBoxDetector detector(queryBox, static_cast<const btBoxShape*>(childShape));
+          detector.getClosestPoints(input, points, nullptr);
+        } else {
+          const btConvexShape* convex = static_cast<const btConvexShape*>(childShape);
+          // The distance cut btConvexConvexAlgorithm uses: both margins + the manifold's breaking threshold.
+          const btScalar cut = shape->getMargin() + convex->getMargin() + breaking;
+          input.m_maximumDistanceSquared = cut * cut;
+          btGjkPairDetector gjk(shape.get(), convex, &simplex, &epa);
+          gjk.getClosestPoints(input, points, nullptr);
+        }
+      }
+    }
+  }
+  const double it = double(state.iterations());
+  const double us = std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / it;
+  summary()["tree_us_" + std::to_string(kind) + "_" + std::to_string(bricks)] = us;
+  state.counters["contacts"] = double(points.all) / it;
+  state.counters["contacts_pen"] = double(points.penetrating) / it;
+  state.counters["narrowphase"] = double(narrowphase) / it;
+  state.counters["chunks_per_query"] = double(chunksReached) / it;
+  state.counters["us_per_query"] = us;
+  state.counters["bricks"] = double(grid(bricks).brickCount());
 }
 
 void GridBuild(benchmark::State& state) {
@@ -241,7 +541,11 @@ void GridBuild(benchmark::State& state) {
 BENCHMARK(GridContact)->ArgsProduct({{0, 1, 2}, {10'000, 100'000, 2'000'000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(GridEdit)->Arg(100'000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(GridBuild)->Arg(10'000)->Arg(100'000)->Arg(2'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(btCompound)->Arg(10'000)->Arg(100'000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(btCompoundNaive)->Arg(10'000)->Arg(100'000)->Unit(benchmark::kMicrosecond);
+// Chunk-size sweep at 100k (2..32 m), the chosen 8 m at 10k.
+BENCHMARK(btCompoundChunked)->ArgsProduct({{0, 1, 2}, {100'000}, {2, 4, 8, 16, 32}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(btCompoundChunked)->ArgsProduct({{0, 1, 2}, {10'000}, {kChosenChunkM}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(btCompoundTree)->ArgsProduct({{0, 1, 2}, {10'000, 100'000}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(ConvexApprox)->ArgsProduct({{0, 1, 2, 3, 4, 5}, {1, 2, 3, 4, 5}})->Unit(benchmark::kMicrosecond);
 
 int main(int argc, char** argv) {
@@ -250,12 +554,44 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   auto& s = summary();
-  std::printf("\n== Comparisons (same run)\n");
+  auto has = [&](const std::string& k) { return s.count(k) != 0; };
+  // "x faster" when our time is lower, "x slower" when it is higher.
+  auto verdict = [](double ours, double theirs) {
+    char buf[48];
+    if (ours <= theirs)
+      std::snprintf(buf, sizeof buf, "grid %.2fx faster", theirs / ours);
+    else
+      std::snprintf(buf, sizeof buf, "grid %.2fx slower", ours / theirs);
+    return std::string(buf);
+  };
+  const char* shapeNames[] = {"0.5 m box", "capsule", "8 m box"};
+  std::printf("\n== Comparisons (same run; our grid with LOD off, exact shapes, vs Bullet 3.24)\n");
   for (uint32_t n : {10'000u, 100'000u}) {
-    const std::string k = std::to_string(n);
-    if (s.count("bt_us_" + k) && s.count("grid_us_0_" + k))
-      std::printf("box contact query, %u bricks: btCompoundShape %.1f us, grid %.2f us (LOD off), %.2f us (LOD on): %.0fx faster\n",
-                  n, s["bt_us_" + k], s["grid_us_0_" + k], s["grid_us_0_" + k + "_lod"], s["bt_us_" + k] / s["grid_us_0_" + k]);
+    const std::string nk = std::to_string(n);
+    for (int kind = 0; kind < 3; ++kind) {
+      const std::string g = "grid_us_" + std::to_string(kind) + "_" + nk;
+      if (!has(g)) continue;
+      const double ours = s[g];
+      std::printf("%-9s %6u bricks: grid %.2f us", shapeNames[kind], n, ours);
+      const std::string c8 = "chunked_us_" + std::to_string(kind) + "_" + nk + "_" + std::to_string(kChosenChunkM);
+      if (has(c8)) std::printf(" | btCompoundChunked %d m %.2f us: %s", kChosenChunkM, s[c8], verdict(ours, s[c8]).c_str());
+      // The sweep's fastest chunk size for this shape, if another size won.
+      int bestM = 0;
+      for (int m : {2, 4, 8, 16, 32}) {
+        const std::string k = "chunked_us_" + std::to_string(kind) + "_" + nk + "_" + std::to_string(m);
+        if (has(k) && (!bestM || s[k] < s["chunked_us_" + std::to_string(kind) + "_" + nk + "_" + std::to_string(bestM)])) bestM = m;
+      }
+      if (bestM && bestM != kChosenChunkM) {
+        const double b = s["chunked_us_" + std::to_string(kind) + "_" + nk + "_" + std::to_string(bestM)];
+        std::printf(" | best chunk %d m %.2f us: %s", bestM, b, verdict(ours, b).c_str());
+      }
+      const std::string tr = "tree_us_" + std::to_string(kind) + "_" + nk;
+      if (has(tr)) std::printf(" | btCompoundTree %.2f us: %s", s[tr], verdict(ours, s[tr]).c_str());
+      if (kind == 0 && has("bt_us_" + nk))
+        std::printf(" | naive btCompound (one compound, bounds boxes) %.1f us: %s", s["bt_us_" + nk], verdict(ours, s["bt_us_" + nk]).c_str());
+      if (has(g + "_lod")) std::printf(" | grid LOD on %.2f us", s[g + "_lod"]);
+      std::printf("\n");
+    }
   }
   return 0;
 }

@@ -10,7 +10,19 @@
 // Edit/<Index>: insert, remove and update at 1M (ns per op). Overlap2m/<Index>, RayClosest200m/
 // <Index>, LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs
 // reversed child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again.
-// After the run a summary prints each comparison's ratio.
+//
+// btDbvt comes in two setups. `btDbvt` (naive) is the tree as incremental insert() leaves it.
+// `btDbvtOptimized` is what a Bullet user does after a bulk build: the same inserts, then
+// optimizeTopDown() (Bullet's default bottom-up threshold, 128, as btDbvtBroadphase::optimize()
+// uses). Rows: Overlap2m_btDbvtOptimized and RayClosest200m_btDbvtOptimized query the same 1M
+// tree after optimizeTopDown(); Load_btDbvtOptimized, LoadLighthouse_btDbvtOptimized and
+// LoadLighthouseTiled_btDbvtOptimized time the bulk load a user would write: insert every
+// brick, optimizeTopDown(), then the same per-brick queries (each then sees every brick, so
+// hits_per_query is higher than in the incremental rows). Edit rows stay naive: a user does not
+// re-optimise after each edit. btDbvt box tests are counted by a walk identical to collideTV's
+// (overlaps) and rayTest's (rays), over the same queries, outside the timed loop.
+// After the run a summary prints each comparison's ratio, OctoBVH vs btDbvtOptimized first and
+// vs the naive btDbvt second.
 #include <BulletCollision/BroadphaseCollision/btDbvt.h>
 #include <benchmark/benchmark.h>
 #include <btBulletCollisionCommon.h>
@@ -137,6 +149,34 @@ uint64_t dbvtOverlap(const btDbvt& tree, const btDbvtVolume& vol, std::vector<co
   return hits;
 }
 
+// btDbvt::rayTest's walk (every node popped is one btRayAabb2 slab test, both children pushed
+// on a hit) with the tests counted. Returns the box tests of one ray.
+uint64_t dbvtRayTests(const btDbvt& tree, const btVector3& from, const btVector3& to, std::vector<const btDbvtNode*>& stack) {
+  if (!tree.m_root) return 0;
+  btVector3 dir = to - from;
+  dir.normalize();
+  btVector3 inv;
+  for (int i = 0; i < 3; ++i) inv[i] = dir[i] == btScalar(0) ? btScalar(BT_LARGE_FLOAT) : btScalar(1) / dir[i];
+  unsigned signs[3] = {inv[0] < 0, inv[1] < 0, inv[2] < 0};
+  const btScalar lambdaMax = dir.dot(to - from);
+  uint64_t tests = 0;
+  stack.clear();
+  stack.push_back(tree.m_root);
+  while (!stack.empty()) {
+    const btDbvtNode* n = stack.back();
+    stack.pop_back();
+    ++tests;
+    btVector3 bounds[2] = {n->volume.Mins(), n->volume.Maxs()};
+    btScalar tmin = 1, lambdaMin = 0;
+    if (!btRayAabb2(from, inv, signs, bounds, tmin, lambdaMin, lambdaMax)) continue;
+    if (n->isinternal()) {
+      stack.push_back(n->childs[0]);
+      stack.push_back(n->childs[1]);
+    }
+  }
+  return tests;
+}
+
 struct ClosestRay : btDbvt::ICollide {
   btVector3 from, dir;
   float best;
@@ -217,6 +257,39 @@ void loadDbvt(benchmark::State& state, std::span<const Aabb> bricks, const std::
   }
 }
 
+// The bulk load a Bullet user writes: insert every brick, optimizeTopDown(), then the same
+// per-brick queries (collideTV; box tests counted by the same walk). Time includes the optimize.
+void loadDbvtOptimized(benchmark::State& state, std::span<const Aabb> bricks, const std::string& key) {
+  const uint32_t n = uint32_t(bricks.size());
+  for (auto _ : state) {
+    btDbvt tree;
+    std::vector<const btDbvtNode*> stack;
+    uint64_t hits = 0, tests = 0;
+    const auto t = Clock::now();
+    for (uint32_t i = 0; i < n; ++i) tree.insert(volume(bricks[i]), nullptr);
+    const double insertS = secondsSince(t);
+    const auto to = Clock::now();
+    tree.optimizeTopDown();
+    const double optimizeS = secondsSince(to);
+    const auto tq = Clock::now();
+    for (uint32_t i = 0; i < n; ++i) hits += dbvtOverlap(tree, volume(around(bricks[i])), stack, tests);
+    const double queryS = secondsSince(tq);
+    const double s = secondsSince(t);
+    state.counters["bricks"] = double(n);
+    state.counters["box_tests"] = double(tests);
+    state.counters["box_tests_per_brick"] = double(tests) / n;
+    state.counters["ns_per_brick"] = s * 1e9 / n;
+    state.counters["insert_ms"] = insertS * 1e3;
+    state.counters["optimize_ms"] = optimizeS * 1e3;
+    state.counters["query_ms"] = queryS * 1e3;
+    state.counters["hits_per_query"] = double(hits) / n;
+    state.counters["bytes_per_element"] = double(sizeof(btDbvtNode)) * (2.0 * n - 1) / n;
+    summary()["load_tests_btDbvtOptimized_" + key] = double(tests);
+    summary()["load_s_btDbvtOptimized_" + key] = s;
+    summary()["load_n_" + key] = double(n);
+  }
+}
+
 template <class Index>
 void loadWith(benchmark::State& state, const char* name) {
   const uint32_t n = uint32_t(state.range(0));
@@ -229,6 +302,12 @@ void Load_btDbvt(benchmark::State& state) {
   const uint32_t n = uint32_t(state.range(0));
   loadDbvt(state, build(n), std::to_string(n));
 }
+void Load_btDbvtOptimized(benchmark::State& state) {
+  const uint32_t n = uint32_t(state.range(0));
+  loadDbvtOptimized(state, build(n), std::to_string(n));
+}
+
+struct btDbvtOptimizedTag {};  // selects loadDbvtOptimized in loadLighthouse
 
 // The same workload on the real save, untiled ("lighthouse") or tiled ("lighthouse_tiled").
 template <class Index>
@@ -242,6 +321,8 @@ void loadLighthouse(benchmark::State& state, const char* name, bool tiled) {
   const std::string key = tiled ? "lighthouse_tiled" : "lighthouse";
   if constexpr (std::is_same_v<Index, btDbvt>) {
     loadDbvt(state, bricks, key);
+  } else if constexpr (std::is_same_v<Index, btDbvtOptimizedTag>) {
+    loadDbvtOptimized(state, bricks, key);
   } else {
     loadIndex<Index>(state, bricks, name, key);
   }
@@ -249,9 +330,11 @@ void loadLighthouse(benchmark::State& state, const char* name, bool tiled) {
 void LoadLighthouse_OctoBVH(benchmark::State& s) { loadLighthouse<bw::OctoBvh>(s, "OctoBVH", false); }
 void LoadLighthouse_LooseOctree(benchmark::State& s) { loadLighthouse<bw::LooseOctree>(s, "LooseOctree", false); }
 void LoadLighthouse_btDbvt(benchmark::State& s) { loadLighthouse<btDbvt>(s, "btDbvt", false); }
+void LoadLighthouse_btDbvtOptimized(benchmark::State& s) { loadLighthouse<btDbvtOptimizedTag>(s, "btDbvtOptimized", false); }
 void LoadLighthouseTiled_OctoBVH(benchmark::State& s) { loadLighthouse<bw::OctoBvh>(s, "OctoBVH", true); }
 void LoadLighthouseTiled_LooseOctree(benchmark::State& s) { loadLighthouse<bw::LooseOctree>(s, "LooseOctree", true); }
 void LoadLighthouseTiled_btDbvt(benchmark::State& s) { loadLighthouse<btDbvt>(s, "btDbvt", true); }
+void LoadLighthouseTiled_btDbvtOptimized(benchmark::State& s) { loadLighthouse<btDbvtOptimizedTag>(s, "btDbvtOptimized", true); }
 
 // ---------------------------------------------------------------- 1M prebuilt indices
 
@@ -271,15 +354,25 @@ Index& prebuilt() {
 struct DbvtBuild {
   btDbvt tree;
   std::vector<btDbvtNode*> leaves;
+  double optimizeSeconds = 0;  // optimizeTopDown() time (optimized build only)
 };
-DbvtBuild& prebuiltDbvt() {
-  static std::unique_ptr<DbvtBuild> d;
-  if (!d) {
-    d = std::make_unique<DbvtBuild>();
+// The 1M tree as incremental inserts leave it (naive) or, as a separate copy built by the same
+// inserts, after optimizeTopDown() (what a user calls after a bulk build). Separate trees, so
+// Edit_btDbvt's edits never reach the optimized one and the order of the rows does not matter.
+DbvtBuild& prebuiltDbvt(bool optimized = false) {
+  static std::unique_ptr<DbvtBuild> d[2];
+  auto& p = d[optimized ? 1 : 0];
+  if (!p) {
+    p = std::make_unique<DbvtBuild>();
     const auto& b = build(kMillion);
-    for (uint32_t i = 0; i < kMillion; ++i) d->leaves.push_back(d->tree.insert(volume(b[i]), nullptr));
+    for (uint32_t i = 0; i < kMillion; ++i) p->leaves.push_back(p->tree.insert(volume(b[i]), nullptr));
+    if (optimized) {
+      const auto t = Clock::now();
+      p->tree.optimizeTopDown();
+      p->optimizeSeconds = secondsSince(t);
+    }
   }
-  return *d;
+  return *p;
 }
 
 // Queries centred on random existing bricks so they land where the geometry is.
@@ -387,27 +480,42 @@ void overlapWith(benchmark::State& state, const char* name) {
   const auto centres = queryCentres(4096, 11);
   bw::QueryStats st;
   uint64_t hits = 0, q = 0;
+  const auto t0 = Clock::now();
   for (auto _ : state) {
     const Aabb box = Aabb::fromCenterHalf(centres[q++ & 4095], Vec3f::Constant(1.f));
     index.overlap(box, 1, [&](uint32_t) { ++hits; }, &st);
   }
+  summary()[std::string("overlap_us_") + name] = secondsSince(t0) * 1e6 / double(state.iterations());
   state.counters["box_tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
   state.counters["hits"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
   summary()[std::string("overlap_tests_") + name] = double(st.boxTests) / double(state.iterations());
 }
 void Overlap2m_OctoBVH(benchmark::State& state) { overlapWith<bw::OctoBvh>(state, "OctoBVH"); }
 void Overlap2m_LooseOctree(benchmark::State& state) { overlapWith<bw::LooseOctree>(state, "LooseOctree"); }
-void Overlap2m_btDbvt(benchmark::State& state) {
-  DbvtBuild& d = prebuiltDbvt();
+void overlapDbvt(benchmark::State& state, bool optimized, const std::string& name) {
+  DbvtBuild& d = prebuiltDbvt(optimized);
   const auto centres = queryCentres(4096, 11);
   CountHits hits;
   uint64_t q = 0;
+  const auto t0 = Clock::now();
   for (auto _ : state) {
     const Aabb box = Aabb::fromCenterHalf(centres[q++ & 4095], Vec3f::Constant(1.f));
     d.tree.collideTV(d.tree.m_root, volume(box), hits);
   }
+  const double us = secondsSince(t0) * 1e6 / double(state.iterations());
+  // Box tests of the same 4096 queries, walked as collideTV walks them (untimed).
+  std::vector<const btDbvtNode*> stack;
+  uint64_t tests = 0;
+  for (const Vec3f& c : centres) dbvtOverlap(d.tree, volume(Aabb::fromCenterHalf(c, Vec3f::Constant(1.f))), stack, tests);
   state.counters["hits"] = benchmark::Counter(double(hits.hits), benchmark::Counter::kAvgIterations);
+  state.counters["box_tests"] = double(tests) / double(centres.size());
+  state.counters["max_depth"] = double(btDbvt::maxdepth(d.tree.m_root));
+  if (optimized) state.counters["optimize_ms"] = d.optimizeSeconds * 1e3;
+  summary()["overlap_tests_" + name] = double(tests) / double(centres.size());
+  summary()["overlap_us_" + name] = us;
 }
+void Overlap2m_btDbvt(benchmark::State& state) { overlapDbvt(state, false, "btDbvt"); }
+void Overlap2m_btDbvtOptimized(benchmark::State& state) { overlapDbvt(state, true, "btDbvtOptimized"); }
 
 // ---------------------------------------------------------------- rays
 
@@ -418,12 +526,14 @@ void rayWith(benchmark::State& state, const char* key, float length, bw::RayChil
   const auto dirs = rayDirections(4096, 14);
   bw::QueryStats st;
   uint64_t hits = 0, q = 0;
+  const auto t0 = Clock::now();
   for (auto _ : state) {
     const uint64_t i = q++ & 4095;
     // Start 3 units outside the brick the ray is aimed from, so it does not begin inside it.
     const bw::Ray ray = bw::Ray::make(origins[i] + dirs[i] * 3.f, dirs[i], length);
     hits += index.raycastClosest(ray, 1, &st, bw::AabbRayExact{}, order).hit();
   }
+  summary()[std::string(key) + "_us"] = secondsSince(t0) * 1e6 / double(state.iterations());
   state.counters["box_tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
   state.counters["hit_rate"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
   summary()[key] = double(st.boxTests) / double(state.iterations());
@@ -433,23 +543,42 @@ void RayClosest200m_LooseOctree(benchmark::State& s) { rayWith<bw::LooseOctree>(
 void RayOrder_OctoBVH_FrontToBack(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "order_tests_front", 2000.f, bw::RayChildOrder::FrontToBack); }
 void RayOrder_OctoBVH_Reversed(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "order_tests_reversed", 2000.f, bw::RayChildOrder::Reversed); }
 
-void RayClosest200m_btDbvt(benchmark::State& state) {
-  DbvtBuild& d = prebuiltDbvt();
+void rayDbvt(benchmark::State& state, bool optimized, const std::string& name) {
+  DbvtBuild& d = prebuiltDbvt(optimized);
   const auto origins = queryCentres(4096, 13);
   const auto dirs = rayDirections(4096, 14);
+  auto endpoints = [&](uint64_t i) {
+    const Vec3f o = origins[i] + dirs[i] * 3.f, e = o + dirs[i] * 200.f;
+    return std::pair(btVector3(o.x(), o.y(), o.z()), btVector3(e.x(), e.y(), e.z()));
+  };
   uint64_t hits = 0, q = 0;
+  const auto t0 = Clock::now();
   for (auto _ : state) {
     const uint64_t i = q++ & 4095;
-    const Vec3f o = origins[i] + dirs[i] * 3.f, e = o + dirs[i] * 200.f;
+    const auto [from, to] = endpoints(i);
     ClosestRay cb;
-    cb.from = btVector3(o.x(), o.y(), o.z());
+    cb.from = from;
     cb.dir = btVector3(dirs[i].x(), dirs[i].y(), dirs[i].z());
     cb.best = 200.f;
-    btDbvt::rayTest(d.tree.m_root, cb.from, btVector3(e.x(), e.y(), e.z()), cb);
+    btDbvt::rayTest(d.tree.m_root, from, to, cb);
     hits += cb.hit != nullptr;
   }
+  const double us = secondsSince(t0) * 1e6 / double(state.iterations());
+  // Box tests of the same 4096 rays, walked as rayTest walks them (untimed).
+  std::vector<const btDbvtNode*> stack;
+  uint64_t tests = 0;
+  for (uint64_t i = 0; i < 4096; ++i) {
+    const auto [from, to] = endpoints(i);
+    tests += dbvtRayTests(d.tree, from, to, stack);
+  }
   state.counters["hit_rate"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
+  state.counters["box_tests"] = double(tests) / 4096.0;
+  if (optimized) state.counters["optimize_ms"] = d.optimizeSeconds * 1e3;
+  summary()["ray_tests_" + name] = double(tests) / 4096.0;
+  summary()["ray_tests_" + name + "_us"] = us;
 }
+void RayClosest200m_btDbvt(benchmark::State& state) { rayDbvt(state, false, "btDbvt"); }
+void RayClosest200m_btDbvtOptimized(benchmark::State& state) { rayDbvt(state, true, "btDbvtOptimized"); }
 
 // Long rays across the whole build from outside it, aimed at a random brick (they hit).
 template <class Index>
@@ -515,8 +644,12 @@ void printSummary() {
                 key.c_str(), get("load_n_" + key), loose / octo, loose, octo,
                 get("load_s_LooseOctree_" + key) / get("load_s_OctoBVH_" + key), get("load_s_LooseOctree_" + key),
                 get("load_s_OctoBVH_" + key));
+    if (get("load_s_btDbvtOptimized_" + key))
+      std::printf(", btDbvtOptimized (bulk insert + optimizeTopDown + queries)/OctoBVH box tests = %.2fx (%.3g), time = %.2fx (%.2f s)",
+                  get("load_tests_btDbvtOptimized_" + key) / octo, get("load_tests_btDbvtOptimized_" + key),
+                  get("load_s_btDbvtOptimized_" + key) / get("load_s_OctoBVH_" + key), get("load_s_btDbvtOptimized_" + key));
     if (get("load_s_btDbvt_" + key))
-      std::printf(", btDbvt/OctoBVH box tests = %.2fx (%.3g), time = %.2fx (%.2f s)", get("load_tests_btDbvt_" + key) / octo,
+      std::printf(", naive btDbvt/OctoBVH box tests = %.2fx (%.3g), time = %.2fx (%.2f s)", get("load_tests_btDbvt_" + key) / octo,
                   get("load_tests_btDbvt_" + key), get("load_s_btDbvt_" + key) / get("load_s_OctoBVH_" + key),
                   get("load_s_btDbvt_" + key));
     std::printf("\n");
@@ -527,10 +660,26 @@ void printSummary() {
   if (get("long_tests_OctoBVH"))
     std::printf("long rays: LooseOctree/OctoBVH box tests = %.2fx (%.0f vs %.0f)\n",
                 get("long_tests_LooseOctree") / get("long_tests_OctoBVH"), get("long_tests_LooseOctree"), get("long_tests_OctoBVH"));
-  if (get("ray_tests_OctoBVH"))
-    std::printf("200 m rays: LooseOctree/OctoBVH box tests = %.2fx\n", get("ray_tests_LooseOctree") / get("ray_tests_OctoBVH"));
-  if (get("overlap_tests_OctoBVH"))
-    std::printf("2 m overlaps: LooseOctree/OctoBVH box tests = %.2fx\n", get("overlap_tests_LooseOctree") / get("overlap_tests_OctoBVH"));
+  // Rival/OctoBVH for box tests and time per query: above 1 OctoBVH does less / is faster.
+  auto versus = [&](const char* what, const std::string& octoTests, const std::string& otherTests, const std::string& octoUs,
+                    const std::string& otherUs, const char* rival) {
+    if (!get(octoTests) || !get(otherTests)) return;
+    const double t = get(otherUs) / get(octoUs);
+    std::printf("%s: %s/OctoBVH box tests = %.2fx (%.0f vs %.0f); time %.3g us vs %.3g us: OctoBVH %.2fx %s\n", what, rival,
+                get(otherTests) / get(octoTests), get(otherTests), get(octoTests), get(otherUs), get(octoUs),
+                t >= 1 ? t : 1 / t, t >= 1 ? "faster" : "slower");
+  };
+  versus("200 m rays", "ray_tests_OctoBVH", "ray_tests_btDbvtOptimized", "ray_tests_OctoBVH_us", "ray_tests_btDbvtOptimized_us",
+         "btDbvtOptimized");
+  versus("200 m rays", "ray_tests_OctoBVH", "ray_tests_btDbvt", "ray_tests_OctoBVH_us", "ray_tests_btDbvt_us", "naive btDbvt");
+  versus("200 m rays", "ray_tests_OctoBVH", "ray_tests_LooseOctree", "ray_tests_OctoBVH_us", "ray_tests_LooseOctree_us",
+         "LooseOctree");
+  versus("2 m overlaps", "overlap_tests_OctoBVH", "overlap_tests_btDbvtOptimized", "overlap_us_OctoBVH",
+         "overlap_us_btDbvtOptimized", "btDbvtOptimized");
+  versus("2 m overlaps", "overlap_tests_OctoBVH", "overlap_tests_btDbvt", "overlap_us_OctoBVH", "overlap_us_btDbvt",
+         "naive btDbvt");
+  versus("2 m overlaps", "overlap_tests_OctoBVH", "overlap_tests_LooseOctree", "overlap_us_OctoBVH", "overlap_us_LooseOctree",
+         "LooseOctree");
   if (get("insert_ns_OctoBVH"))
     std::printf("edits at 1M: insert ns OctoBVH %.0f, LooseOctree %.0f, btDbvt %.0f; remove ns %.0f, %.0f, %.0f\n",
                 get("insert_ns_OctoBVH"), get("insert_ns_LooseOctree"), get("insert_ns_btDbvt"), get("remove_ns_OctoBVH"),
@@ -543,21 +692,26 @@ BENCHMARK(Load_OctoBVH)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iteration
 BENCHMARK(Load_LooseOctree)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 // btDbvt stops at 1M: its incremental load is superlinear here (1M took 48 s, 4M did not finish in 5 min).
 BENCHMARK(Load_btDbvt)->Arg(100'000)->Arg(1'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(Load_btDbvtOptimized)->Arg(100'000)->Arg(1'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_LooseOctree)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_btDbvt)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouse_btDbvtOptimized)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouseTiled_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouseTiled_LooseOctree)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouseTiled_btDbvt)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouseTiled_btDbvtOptimized)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_OctoBVH)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_LooseOctree)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(Edit_btDbvt)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(Overlap2m_OctoBVH)->Unit(benchmark::kMicrosecond);
 BENCHMARK(Overlap2m_LooseOctree)->Unit(benchmark::kMicrosecond);
 BENCHMARK(Overlap2m_btDbvt)->Unit(benchmark::kMicrosecond);
+BENCHMARK(Overlap2m_btDbvtOptimized)->Unit(benchmark::kMicrosecond);
 BENCHMARK(RayClosest200m_OctoBVH)->Unit(benchmark::kMicrosecond);
 BENCHMARK(RayClosest200m_LooseOctree)->Unit(benchmark::kMicrosecond);
 BENCHMARK(RayClosest200m_btDbvt)->Unit(benchmark::kMicrosecond);
+BENCHMARK(RayClosest200m_btDbvtOptimized)->Unit(benchmark::kMicrosecond);
 BENCHMARK(RayOrder_OctoBVH_FrontToBack)->Unit(benchmark::kMicrosecond);
 BENCHMARK(RayOrder_OctoBVH_Reversed)->Unit(benchmark::kMicrosecond);
 BENCHMARK(LongRay_OctoBVH)->Unit(benchmark::kMicrosecond);
