@@ -194,6 +194,7 @@ BulletBaseline::BulletBaseline(const World& w, BulletSetup setup, float chunkSiz
     m.world.addRigidBody(body);
     m.dynamic[i] = dyn;
   }
+  m.broadphase.optimize();  // the static chunks' tree built top-down once, as a user does after loading
   if (!anyRayGrid) m.rays.count = 0;
   buildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }

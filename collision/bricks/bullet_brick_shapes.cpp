@@ -1,5 +1,7 @@
 #include "collision/bricks/bullet_brick_shapes.h"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -18,6 +20,30 @@ size_t BulletBrickShapes::KeyHash::operator()(const Key& k) const {
   return size_t(h);
 }
 
+namespace {
+// Corners of the convex region n . x <= d of `count` planes: every point where three planes
+// meet that lies inside all of them (within `tolerance`). note: Bullet's
+// btGeometryUtil::getVerticesFromPlaneEquations accepts points up to 1 cm outside, which on a
+// shrunk brick is most of the margin.
+std::vector<Vec3f> planeCorners(const BrickPlane* planes, int count, float tolerance) {
+  std::vector<Vec3f> corners;
+  for (int i = 0; i < count; ++i)
+    for (int j = i + 1; j < count; ++j)
+      for (int k = j + 1; k < count; ++k) {
+        Eigen::Matrix3d m;
+        m.row(0) = planes[i].n.cast<double>().transpose();
+        m.row(1) = planes[j].n.cast<double>().transpose();
+        m.row(2) = planes[k].n.cast<double>().transpose();
+        if (std::abs(m.determinant()) < 1e-9) continue;  // two of them parallel
+        const Eigen::Vector3d x = m.partialPivLu().solve(Eigen::Vector3d(planes[i].d, planes[j].d, planes[k].d));
+        bool inside = true;
+        for (int p = 0; p < count && inside; ++p) inside = planes[p].n.cast<double>().dot(x) <= double(planes[p].d) + tolerance;
+        if (inside) corners.push_back(x.cast<float>());
+      }
+  return corners;
+}
+}  // namespace
+
 btCollisionShape* BulletBrickShapes::shapeFor(const Brick& b) {
   const Key key{uint8_t(b.shape), b.shape == BrickShape::Cylinder ? b.sides : uint8_t(0), b.halfSize.x(), b.halfSize.y(),
                 b.halfSize.z()};
@@ -29,16 +55,21 @@ btCollisionShape* BulletBrickShapes::shapeFor(const Brick& b) {
   } else if (b.shape == BrickShape::Cylinder && b.halfSize.x() == b.halfSize.y()) {
     shape = std::make_unique<btCylinderShapeZ>(half);  // round, margin inside like the box
   } else {
-    // Wedges, corner wedges, oval cylinders: the hull of the exact vertices. A hull's margin
-    // lies outside its points, so keep it small beside the brick (Bullet's default is 4 cm).
+    // Wedges, corner wedges, oval cylinders: a hull with Bullet's margin, the expert way: the
+    // shape's face planes moved in by the margin, so hull plus margin is the brick (rounded at
+    // its edges) and GJK keeps its margin to work with. The margin is Bullet's 4 cm, at most a
+    // tenth of the smallest half size (as btBoxShape caps its own).
     Brick canonical = b;
     canonical.position = Vec3f::Zero();
     canonical.rotation = AxisRotation::identity();
-    Vec3f v[kMaxBrickVertices];
-    const int n = canonicalBrickVertices(canonical, v);
+    const float margin = std::min(0.04f, 0.1f * b.halfSize.minCoeff());
+    BrickPlane planes[kMaxBrickPlanes];
+    const int n = canonicalBrickPlanes(canonical, planes);
+    for (int i = 0; i < n; ++i) planes[i].d -= margin;
+    const std::vector<Vec3f> points = planeCorners(planes, n, 1e-5f * (1.f + b.halfSize.maxCoeff()));
     auto hull = std::make_unique<btConvexHullShape>();
-    for (int i = 0; i < n; ++i) hull->addPoint(btVector3(v[i].x(), v[i].y(), v[i].z()), i + 1 == n);
-    hull->setMargin(std::min(0.04f, 0.1f * b.halfSize.minCoeff()));
+    for (size_t i = 0; i < points.size(); ++i) hull->addPoint(btVector3(points[i].x(), points[i].y(), points[i].z()), i + 1 == points.size());
+    hull->setMargin(margin);
     shape = std::move(hull);
   }
   btCollisionShape* raw = shape.get();
@@ -84,6 +115,9 @@ std::vector<BulletBrickChunk> buildBulletChunks(const BrickGrid& grid, float chu
       const Brick& b = grid.brick(id);
       c.shape->addChildShape(BulletBrickShapes::childTransform(b, c.origin), shapes.shapeFor(b));
     }
+    // The compound's tree was built by incremental inserts; a static chunk's is rebuilt
+    // top-down once, as a user does (its leaves, each child's node, survive the rebuild).
+    c.shape->getDynamicAabbTree()->optimizeTopDown();
     c.bricks = uint32_t(ids.size());
     chunks.push_back(std::move(c));
   }

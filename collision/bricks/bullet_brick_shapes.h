@@ -2,7 +2,7 @@
 /// Bricks as a Bullet expert builds them, for the baselines (bench_grid, the world's Bullet
 /// engine): one shared shape per distinct brick (boxes as btBoxShape, round cylinders as
 /// btCylinderShapeZ, wedges, corner wedges and oval cylinders as btConvexHullShape of their
-/// exact vertices), placed as compound children by the brick's position and rotation, and the
+/// face planes moved in by the margin, so hull plus margin is the brick), placed as compound children by the brick's position and rotation, and the
 /// grid cut into cubic chunks, each its own btCompoundShape. A chunk is what a pair walks:
 /// Bullet's compound algorithm touches every child of a compound once per pair and step, so
 /// users split large static structures into chunks instead of one compound of every brick.
@@ -56,7 +56,7 @@ struct BulletBrickChunk {
 };
 
 /// Cuts the grid into cubes of `chunkSize` (grid units) by brick centre and builds one compound
-/// per non-empty cube (its dynamic AABB tree on). Chunks come out in a fixed order (by cube
+/// per non-empty cube (its dynamic AABB tree on, rebuilt top-down). Chunks come out in a fixed order (by cube
 /// coordinates), so two builds of the same grid are equal. Throws InvalidInput when chunkSize
 /// is not positive and finite.
 std::vector<BulletBrickChunk> buildBulletChunks(const BrickGrid& grid, float chunkSize, BulletBrickShapes& shapes);

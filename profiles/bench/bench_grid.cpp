@@ -315,9 +315,6 @@ ChunkedWorld& chunkedWorld(uint32_t bricks, int chunkM) {
     w->chunks = buildBulletChunks(g, float(chunkM), w->shapes);
     for (size_t i = 0; i < w->chunks.size(); ++i) {
       const BulletBrickChunk& c = w->chunks[i];
-      // note: a static chunk's own tree is built by incremental inserts; rebuild it top-down once,
-      // as a user would. Leaves (and so each child's m_node) survive the rebuild.
-      c.shape->getDynamicAabbTree()->optimizeTopDown();
       auto o = std::make_unique<btCollisionObject>();
       o->setCollisionShape(c.shape.get());
       o->setWorldTransform(toBullet(gridPose) * btTransform(btQuaternion::getIdentity(), btVector3(c.origin.x(), c.origin.y(), c.origin.z())));

@@ -47,7 +47,7 @@ SceneDescription floorScene(uint32_t crates, uint32_t rays, const Vec3d& at) {
 }
 
 TEST(BulletBaseline, ExpertLandsCratesWithoutLettingAnyThrough) {
-  for (const Vec3d at : {Vec3d(0, 0, 0), Vec3d(3000, -2000, 50)}) {
+  for (const Vec3d& at : {Vec3d(0, 0, 0), Vec3d(3000, -2000, 50)}) {
     const SceneDescription scene = floorScene(60, 0, at);
     World judge(scene, 1);
     BulletBaseline bullet(judge, BulletSetup::Expert);
