@@ -55,17 +55,23 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
     }
     order_[j] = v;
   }
+  const int a1 = (axis_ + 1) % 3, a2 = (axis_ + 2) % 3;
+  sorted_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const WorldAabb& b = bounds[order_[i]];
+    sorted_[i] = {b.min[axis_], b.max[axis_], b.min[a1], b.max[a1], b.min[a2], b.max[a2], order_[i], isStatic[order_[i]]};
+  }
   pairs.clear();
   tests_ = 0;
   for (uint32_t i = 0; i < n; ++i) {
-    const uint32_t a = order_[i];
-    const double maxA = bounds[a].max[axis_];
+    const Sorted& a = sorted_[i];
     for (uint32_t j = i + 1; j < n; ++j) {
-      const uint32_t b = order_[j];
+      const Sorted& b = sorted_[j];
       ++tests_;
-      if (bounds[b].min[axis_] > maxA) break;  // sorted by min: nothing further can overlap
-      if (isStatic[a] && isStatic[b]) continue;
-      if (bounds[a].overlaps(bounds[b])) pairs.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
+      if (b.lo > a.hi) break;  // sorted by min: nothing further can overlap
+      if (a.isStatic && b.isStatic) continue;
+      if (a.lo1 <= b.hi1 && b.lo1 <= a.hi1 && a.lo2 <= b.hi2 && b.lo2 <= a.hi2)
+        pairs.push_back(a.body < b.body ? BodyPair{a.body, b.body} : BodyPair{b.body, a.body});
     }
   }
   std::sort(pairs.begin(), pairs.end());

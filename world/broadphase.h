@@ -44,6 +44,15 @@ class SweepAndPrune {
 
  private:
   std::vector<uint32_t> order_;  // body ids sorted by min on axis_, kept between frames
+  // The bounds in that order, copied each update: the sweep then reads memory in order instead
+  // of jumping through order_ (the pile of a landing rain overlaps dozens of bodies per body).
+  struct Sorted {
+    double lo, hi;                // on axis_
+    double lo1, hi1, lo2, hi2;    // on the two other axes
+    uint32_t body;
+    uint8_t isStatic;
+  };
+  std::vector<Sorted> sorted_;
   int axis_ = 0;
   uint64_t tests_ = 0;
 };

@@ -71,7 +71,7 @@ void World::substep(float dt, int index) {
   {
     ProfileZone z(profiler_, "broadphase", stage + 0);
     computeBounds();
-    broadphase_.update(bounds_, isStatic_, pairs_);
+    findPairs();
   }
   stats_.broadphaseMs += msSince(t);
   t = Clock::now();

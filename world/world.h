@@ -145,6 +145,8 @@ class World {
   // Bounds and contacts (contact_generation.cpp, terrain_pairs.cpp).
   void computeBounds();
   WorldAabb boundsOf(uint32_t body, float& reach) const;
+  // The broadphase over proxies (broadphase_proxies.cpp): pairs_ from bounds_.
+  void findPairs();
   void generateContacts(float dt);
   void terrainPairs(float dt);
   bool canCollide(uint32_t a, uint32_t b) const;
@@ -180,6 +182,20 @@ class World {
   std::vector<uint8_t> isStatic_;
   std::vector<float> reach_;  // per body: speed + spin x radius (m/s), from computeBounds()
   SweepAndPrune broadphase_;
+  // Broadphase proxies: a large static grid enters the sweep as the boxes covering its bricks a
+  // few OctoBVH levels down (BrickGrid::coverBoxes, at most tuning::kCoverBoxes) instead of one box around it all, so a body
+  // above a city's streets pairs with the city only near a building; other bodies as their box.
+  struct GridCover {
+    uint32_t body;
+    uint64_t edit;                   // the grid's edit count when the boxes were taken
+    std::vector<WorldAabb> boxes;    // world frame, with the broadphase margin
+  };
+  std::vector<GridCover> covers_;    // one per large static grid body
+  std::vector<WorldAabb> proxyBounds_;
+  std::vector<uint8_t> proxyStatic_;
+  std::vector<uint32_t> proxyBody_;
+  std::vector<BodyPair> proxyPairs_;
+  std::vector<Aabb> coverScratch_;
   std::vector<BodyPair> pairs_;
   std::vector<std::vector<Contact>> pairContacts_;  // one slot per pair, reused across frames
   std::vector<ContactScratch> scratch_;             // one per pair slot

@@ -13,6 +13,12 @@ inline constexpr float kDefaultFriction = 0.6f;
 /// Body bounds grow by this (m) beyond how far the body can move in one frame, so resting
 /// bodies keep their pairs through small motions and pairs are not found one frame late.
 inline constexpr double kBroadphaseMargin = 0.02;
+/// Static grids of at least this many bricks enter the broadphase as at most kCoverBoxes boxes
+/// covering their bricks (BrickGrid::coverBoxes). 512 measured against 256 and 1024 on
+/// crates_on_grid, city_rain and lighthouse: 1024 slows the sweep more than it saves in pairs,
+/// 256 leaves more pairs that meet nothing (profiles/RESULTS.md, session 5).
+inline constexpr uint32_t kCoverMinBricks = 2048;
+inline constexpr uint32_t kCoverBoxes = 512;
 /// Contacts are made for gaps up to this (m) plus the pair's closing speed x dt: a resting
 /// contact survives micro-separation, and a fast body meets a thin plate before passing it.
 inline constexpr float kSpeculativeMargin = 0.01f;

@@ -144,6 +144,12 @@ class BrickGrid {
   void collideLocal(const QueryShape& shape, const LocalPose& pose, const ContactParams& params,
                     std::vector<LocalContact>& out, ContactStats* stats = nullptr) const;
 
+  /// Boxes that together cover every brick (grid frame), at most `maxBoxes` (at least 1): the
+  /// bounds of the OctoBVH's subtrees at the deepest level whose nodes still fit, and of the
+  /// bricks held above that level (large bricks). A coarse stand-in for the whole grid, kept
+  /// tight by the index under edits (the world's broadphase enters large static grids as these).
+  void coverBoxes(uint32_t maxBoxes, std::vector<Aabb>& out) const;
+
   // ---- convex approximation ----
   /// Hull of the bricks met in the first `depth` levels of the OctoBVH plus the bounds of the
   /// subtrees left at that depth; a box when the hull is exactly its bounds. Cached per depth,

@@ -35,6 +35,43 @@ void collectPoints(const BrickGrid& grid, uint32_t c, int s, int level, int dept
 
 }  // namespace
 
+void BrickGrid::coverBoxes(uint32_t maxBoxes, std::vector<Aabb>& out) const {
+  out.clear();
+  if (brickCount() == 0) return;
+  // Level by level from the root while the next level still fits in maxBoxes: chains of
+  // single children (a grid far from the origin sits under a few) cost no boxes.
+  struct Node {
+    uint32_t cluster;
+    int slot;
+  };
+  std::vector<Node> frontier{{index_.rootCluster(), 0}}, next;
+  std::vector<Aabb> held;  // bricks held by nodes already expanded (large bricks)
+  for (;;) {
+    next.clear();
+    size_t heldHere = 0;
+    bool grew = false;
+    for (const Node& n : frontier) {
+      const NodeCluster& cl = index_.cluster(n.cluster);
+      if (cl.child[n.slot] == kInvalidIndex) {
+        next.push_back(n);  // a leaf stays as it is
+        continue;
+      }
+      grew = true;
+      index_.forEachHeldPublic(cl, n.slot, [&](uint32_t) { ++heldHere; });
+      for (int o = 0; o < 8; ++o)
+        if (!index_.cluster(cl.child[n.slot]).isEmpty(o)) next.push_back({cl.child[n.slot], o});
+    }
+    if (!grew || next.size() + held.size() + heldHere > maxBoxes) break;
+    for (const Node& n : frontier) {
+      const NodeCluster& cl = index_.cluster(n.cluster);
+      if (cl.child[n.slot] != kInvalidIndex) index_.forEachHeldPublic(cl, n.slot, [&](uint32_t e) { held.push_back(index_.bounds(e)); });
+    }
+    std::swap(frontier, next);
+  }
+  for (const Node& n : frontier) out.push_back(index_.cluster(n.cluster).bounds(n.slot));
+  out.insert(out.end(), held.begin(), held.end());
+}
+
 QueryShape ConvexApproximation::shape() const {
   if (isBox) return QueryShape::box(bounds.halfExtent().cwiseMax(Vec3f::Constant(1e-4f)));
   return QueryShape::hull(centered.data(), uint32_t(centered.size()), float(hullVolume));

@@ -479,3 +479,51 @@ TEST(BrickNarrowphase, NormalsDoNotDependOnTheShapeRotation) {
 
 }  // namespace
 }  // namespace bw
+
+namespace bw {
+namespace {
+
+// The boxes a large static grid enters the world's broadphase as: every brick's bounds lie in
+// one of them for every box budget, through edits (removals, bricks placed far outside); there
+// are never more than the budget, and a budget of 8 or more splits the grid (it lies 5 km from
+// the origin, under a chain of single-child nodes that must not use up the budget).
+TEST(BrickGrid, CoverBoxesHoldEveryBrickThroughEdits) {
+  BrickGrid grid(BrickGrid::Config(1u << 14));
+  std::vector<uint32_t> ids;
+  for (const Brick& b : randomBuild(31, 3000, Vec3f(-5000.f, 200.f, 0.f))) ids.push_back(grid.placeBrick(b));
+  SeededRandom r(5);
+  // Slabs as large as the build: the index holds them near its root, above the cover depth.
+  for (int i = 0; i < 3; ++i) ids.push_back(grid.placeBrick(Brick::box(Vec3f(-4970.f + 10.f * float(i), 230.f, 30.f * float(i)), Vec3f(40.f, 35.f, 0.5f))));
+  auto check = [&](const char* when) {
+    for (uint32_t budget : {1u, 8u, 64u, 512u, 4096u}) {
+      std::vector<Aabb> boxes;
+      grid.coverBoxes(budget, boxes);
+      ASSERT_FALSE(boxes.empty()) << when;
+      EXPECT_LE(boxes.size(), budget) << when;
+      if (budget >= 8) EXPECT_GT(boxes.size(), 1u) << when << ": budget " << budget;
+      grid.forEachBrick([&](uint32_t id) {
+        const Aabb b = brickBounds(grid.brick(id));
+        EXPECT_TRUE(std::any_of(boxes.begin(), boxes.end(), [&](const Aabb& c) { return c.contains(b); }))
+            << when << ": brick " << id << " outside every cover box with a budget of " << budget;
+      });
+      // Tight: the boxes stay within the grid's bounds.
+      for (const Aabb& c : boxes) EXPECT_TRUE(grid.bounds().contains(c)) << when << " budget " << budget;
+    }
+  };
+  check("built");
+  for (int i = 0; i < 1000; ++i) {
+    const size_t k = r.below(uint32_t(ids.size()));
+    grid.removeBrick(ids[k]);
+    ids.erase(ids.begin() + std::ptrdiff_t(k));
+  }
+  for (int i = 0; i < 50; ++i)
+    grid.placeBrick(randomBrick(r, Vec3f(float(r.uniform(-9000, 9000)), float(r.uniform(-900, 900)), float(r.uniform(-50, 500))), 3.f));
+  check("edited");
+  std::vector<Aabb> empty;
+  BrickGrid none;
+  none.coverBoxes(512, empty);
+  EXPECT_TRUE(empty.empty());
+}
+
+}  // namespace
+}  // namespace bw
