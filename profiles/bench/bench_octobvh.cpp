@@ -232,6 +232,21 @@ void loadIndex(benchmark::State& state, std::span<const Aabb> bricks, const char
   }
 }
 
+// Counters and summary entries of a btDbvt load run (as built or optimised).
+void reportDbvtLoad(benchmark::State& state, const std::string& name, const std::string& key, uint32_t n, uint64_t tests,
+                    uint64_t hits, double s) {
+  state.counters["bricks"] = double(n);
+  state.counters["box_tests"] = double(tests);
+  state.counters["box_tests_per_brick"] = double(tests) / n;
+  state.counters["ns_per_brick"] = s * 1e9 / n;
+  state.counters["hits_per_query"] = double(hits) / n;
+  // btDbvt keeps 2n-1 nodes (leaves + internal), each a btDbvtNode.
+  state.counters["bytes_per_element"] = double(sizeof(btDbvtNode)) * (2.0 * n - 1) / n;
+  summary()["load_tests_" + name + "_" + key] = double(tests);
+  summary()["load_s_" + name + "_" + key] = s;
+  summary()["load_n_" + key] = double(n);
+}
+
 void loadDbvt(benchmark::State& state, std::span<const Aabb> bricks, const std::string& key) {
   const uint32_t n = uint32_t(bricks.size());
   for (auto _ : state) {
@@ -243,17 +258,7 @@ void loadDbvt(benchmark::State& state, std::span<const Aabb> bricks, const std::
       tree.insert(volume(bricks[i]), nullptr);
       hits += dbvtOverlap(tree, volume(around(bricks[i])), stack, tests);
     }
-    const double s = secondsSince(t);
-    state.counters["bricks"] = double(n);
-    state.counters["box_tests"] = double(tests);
-    state.counters["box_tests_per_brick"] = double(tests) / n;
-    state.counters["ns_per_brick"] = s * 1e9 / n;
-    state.counters["hits_per_query"] = double(hits) / n;
-    // btDbvt keeps 2n-1 nodes (leaves + internal), each a btDbvtNode.
-    state.counters["bytes_per_element"] = double(sizeof(btDbvtNode)) * (2.0 * n - 1) / n;
-    summary()["load_tests_btDbvt_" + key] = double(tests);
-    summary()["load_s_btDbvt_" + key] = s;
-    summary()["load_n_" + key] = double(n);
+    reportDbvtLoad(state, "btDbvt", key, n, tests, hits, secondsSince(t));
   }
 }
 
@@ -274,19 +279,10 @@ void loadDbvtOptimized(benchmark::State& state, std::span<const Aabb> bricks, co
     const auto tq = Clock::now();
     for (uint32_t i = 0; i < n; ++i) hits += dbvtOverlap(tree, volume(around(bricks[i])), stack, tests);
     const double queryS = secondsSince(tq);
-    const double s = secondsSince(t);
-    state.counters["bricks"] = double(n);
-    state.counters["box_tests"] = double(tests);
-    state.counters["box_tests_per_brick"] = double(tests) / n;
-    state.counters["ns_per_brick"] = s * 1e9 / n;
+    reportDbvtLoad(state, "btDbvtOptimized", key, n, tests, hits, secondsSince(t));
     state.counters["insert_ms"] = insertS * 1e3;
     state.counters["optimize_ms"] = optimizeS * 1e3;
     state.counters["query_ms"] = queryS * 1e3;
-    state.counters["hits_per_query"] = double(hits) / n;
-    state.counters["bytes_per_element"] = double(sizeof(btDbvtNode)) * (2.0 * n - 1) / n;
-    summary()["load_tests_btDbvtOptimized_" + key] = double(tests);
-    summary()["load_s_btDbvtOptimized_" + key] = s;
-    summary()["load_n_" + key] = double(n);
   }
 }
 
