@@ -101,16 +101,21 @@ Header2 readHeader2(const std::vector<uint8_t>& bytes, int version, const std::s
   return h;
 }
 
-// Checks the components section's framing (count, names, lengths) without interpreting it.
-void checkComponents(const std::vector<uint8_t>& bytes, const std::string& file) {
-  BrsReader r(bytes.data(), bytes.size(), file, "components");
-  const uint32_t n = r.count("components count", 8);
-  for (uint32_t i = 0; i < n; ++i) {
-    r.string("component name");
-    const int32_t len = r.i32("component length");
-    if (len < 0) r.failHere("component length is negative (" + std::to_string(len) + ")");
-    r.take(size_t(len), "component data");
-  }
+// A .brs string inside a bit stream (see BrsReader::string for the encoding).
+std::string BitReader::string(const char* what) {
+  const int32_t n = i32();
+  if (n == std::numeric_limits<int32_t>::min()) failHere(std::string(what) + " has an invalid length");
+  // note: the length is checked against the bits left before anything is allocated.
+  const bool utf16 = n < 0;
+  const uint64_t units = uint64_t(utf16 ? -int64_t(n) : int64_t(n));
+  const uint64_t needed = units * (utf16 ? 16 : 8);
+  if (needed > bitsLeft())
+    failHere(std::string("truncated: ") + what + " needs " + std::to_string(needed / 8) + " bytes, only " +
+             std::to_string(bitsLeft() / 8) + " left");
+  std::string s(size_t(units), '\0');
+  for (uint64_t i = 0; i < units; ++i) s[size_t(i)] = char(bits(utf16 ? 16 : 8) & 0xFF);
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
 }
 
 }  // namespace bw::brs

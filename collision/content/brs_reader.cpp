@@ -2,18 +2,20 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <utility>
 
 #include "collision/bricks/brick_geometry.h"
 #include "collision/content/brs_asset_mapping.h"
+#include "collision/content/brs_components.h"
 #include "collision/content/brs_format.h"
 #include "collision/core/argument_checks.h"
 
 // The build step of the .brs reader: header and section reading come from brs_format.h, asset
-// and orientation mapping from brs_asset_mapping.h; here the brick records are decoded and
-// turned into Bricks.
+// and orientation mapping from brs_asset_mapping.h, the components from brs_components.h; here
+// the brick records are decoded and turned into Bricks, and light components into BuildLights.
 
 namespace bw {
 namespace {
@@ -21,7 +23,7 @@ namespace {
 using brs::AssetMapping;
 using brs::BitReader;
 using brs::BrsReader;
-using brs::checkComponents;
+using brs::Component;
 using brs::Fold;
 using brs::fold180AboutX;
 using brs::foldMinus90AboutX;
@@ -34,6 +36,7 @@ using brs::kUnknownHalfSize;
 using brs::mapAsset;
 using brs::orientationTable;
 using brs::readHeader1;
+using brs::readComponents;
 using brs::readHeader2;
 using brs::readSection;
 
@@ -44,6 +47,31 @@ constexpr int64_t kMaxBrsPosition = int64_t(1) << 30;
 constexpr size_t kMinRecordBytes = 5;
 // Reservations are capped so that a corrupt count cannot allocate ahead of the data that backs it.
 constexpr uint32_t kMaxReserve = 1u << 20;
+
+// One BuildLight per brick carrying a point or spot light component (see brs_reader.h).
+void addLights(const Component& c, float unitsPerBrsUnit, const std::string& file, BrsLoadResult& out) {
+  const bool light = c.name.size() >= 5 && c.name.compare(c.name.size() - 5, 5, "Light") == 0;
+  if (light) out.lightComponentsFound += uint32_t(c.bricks.size());
+  BuildLightKind kind;
+  if (c.name == "BCD_PointLight") kind = BuildLightKind::Point;
+  else if (c.name == "BCD_SpotLight") kind = BuildLightKind::Spot;
+  else return;
+  for (size_t k = 0; k < c.bricks.size(); ++k) {
+    const uint32_t record = c.bricks[k];
+    const BrsBrickRecord& rec = out.records[record];
+    const float stored = c.radius.empty() ? 0.f : c.radius[k];
+    const float radius = (stored > 0.f ? stored : kBrsDefaultLightRadius) * unitsPerBrsUnit;
+    if (!std::isfinite(stored) || !std::isfinite(radius))
+      failFile(file, "components",
+               c.name + ": brick " + std::to_string(record) + ": Radius " + std::to_string(stored) + " is not finite");
+    BuildLight l;
+    l.position = Vec3f(float(rec.position[0]), float(rec.position[1]), float(rec.position[2])) * unitsPerBrsUnit;
+    l.radius = radius;
+    l.kind = kind;
+    out.lights.push_back(l);
+    out.lightRecords.push_back(record);
+  }
+}
 
 }  // namespace
 
@@ -93,7 +121,7 @@ BrsLoadResult parseBrs(const uint8_t* data, size_t size, const std::string& name
          "brick count " + std::to_string(h1.brickCount) + " exceeds the data (" + std::to_string(brickBytes.size()) +
              " bytes hold at most " + std::to_string(brickBytes.size() / kMinRecordBytes) + " records)");
   if (h1.brickCount > 0 && h2.assets.empty()) failFile(name, "header2", "no brick assets for " + std::to_string(h1.brickCount) + " bricks");
-  checkComponents(readSection(file, "components", name), name);
+  const std::vector<Component> components = readComponents(readSection(file, "components", name), h1.brickCount, name);
 
   std::vector<AssetMapping> mappings;
   mappings.reserve(h2.assets.size());
@@ -112,7 +140,7 @@ BrsLoadResult parseBrs(const uint8_t* data, size_t size, const std::string& name
   out.records.reserve(std::min(h1.brickCount, kMaxReserve));
   out.bricks.reserve(std::min(h1.brickCount, kMaxReserve));
   out.assetNames = std::move(h2.assets);
-  BitReader bits(brickBytes, name);
+  BitReader bits(brickBytes.data(), brickBytes.size(), name, "bricks section");
   for (uint32_t i = 0; i < h1.brickCount; ++i) {
     bits.setBrick(i);
     bits.align();
@@ -210,6 +238,10 @@ BrsLoadResult parseBrs(const uint8_t* data, size_t size, const std::string& name
     if (assetHistogram[a] > 0) out.assetCounts[out.assetNames[a]] += assetHistogram[a];
   for (size_t s = 0; s < shapeHistogram.size(); ++s)
     if (shapeHistogram[s] > 0) out.shapeCounts[brickShapeName(BrickShape(s))] = shapeHistogram[s];
+  for (const Component& c : components) {
+    out.componentCounts[c.name] += uint32_t(c.bricks.size());
+    addLights(c, unitsPerBrsUnit, name, out);
+  }
   return out;
 }
 

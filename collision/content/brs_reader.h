@@ -18,7 +18,8 @@
 ///                   v9+: physicalMaterials : string[]
 /// u8 previewFormat; if != 0: i32 length, then that many bytes (an image we skip)
 /// section bricks    bit stream, brickCount records (below)
-/// section components i32 count, then {name : string, i32 byteLength, bytes}[] (checked, not used)
+/// section components i32 count, then count x {name : string, i32 byteLength, byteLength bytes}
+///                   (each component's bytes: a bit stream, below)
 /// ```
 /// A section is `i32 uncompressedSize, i32 compressedSize` then compressedSize bytes of zlib data
 /// (or, when compressedSize is 0, uncompressedSize raw bytes); compressedSize must be smaller
@@ -44,6 +45,32 @@
 /// ```
 /// A brick is indexed when its collision bit is set (v10: the player bit, the one that stops
 /// bodies); the others are counted in collisionOff.
+///
+/// ## Component data (bit stream, same bit order; nothing in it is byte aligned)
+/// A component (a light, an interaction, ...) lists the bricks that carry it and one value per
+/// declared property for each of them. Strings inside the stream are .brs strings (i32 n, then
+/// the bytes) starting at any bit. Verified on Lighthouse_Island (BCD_PointLight, 714 bytes, and
+/// BCD_SpotLight, 1017 bytes, both decode to their last byte).
+/// ```
+/// version      32 bits (i32; 1 in Lighthouse_Island)
+/// bricks       i32 count, then count x uint(max(brickCount, 2)) record indices (< brickCount)
+/// properties   i32 count, then count x {name : string, type : string}
+/// values       for each brick index in order, for each property in order, by type:
+///              Boolean 32 bits (0 or 1)   Float 32-bit IEEE   Color 4 bytes BGRA   Byte 8 bits
+///              Rotator 3 floats (pitch, yaw, roll, degrees)   Class, Object, String: a string
+///              (and, from public readers, not seen in a save we have: Integer 32 bits,
+///              Integer64 64 bits, Double 64 bits, IntVector 3 x 32 bits)
+/// padding      zero bits up to the next byte: the values end in the component's last byte
+///              (Lighthouse_Island: 1 and 4 bits); 8 or more bits left over is an error
+/// ```
+/// Any other type cannot be sized, so the component cannot be decoded: an error naming it.
+/// Properties used: BCD_PointLight (bMatchBrickShape Boolean, Brightness Float, Radius Float,
+/// Color Color, bUseBrickColor Boolean, bCastShadows Boolean) and BCD_SpotLight (Rotation
+/// Rotator, InnerConeAngle Float, OuterConeAngle Float, Brightness, Radius, Color,
+/// bUseBrickColor, bCastShadows) each give a BuildLight at its brick's centre (collision on or
+/// off: a lamp's glass often has none) with Radius in Brickadia units times unitsPerBrsUnit;
+/// a missing or non-positive Radius gives kBrsDefaultLightRadius, a NaN or infinite one is an
+/// error.
 ///
 /// ## Units and frame
 /// Brickadia units: 10 per stud across, 4 per plate of height (a brick is 12); `size` is a half
@@ -98,6 +125,7 @@
 #include <vector>
 
 #include "collision/bricks/brick.h"
+#include "collision/content/build_light.h"
 #include "collision/core/aabb.h"
 #include "collision/core/axis_rotation.h"
 
@@ -130,6 +158,10 @@ std::span<const BrsFixedAsset> brsFixedAssets();
 /// Our rotation with the same matrix as Brickadia's (direction 0..5, rotation 0..3).
 AxisRotation brsOrientation(int direction, int rotation);
 
+/// Radius of a light whose component has no positive Radius, in Brickadia units: the point
+/// light radius most of Lighthouse_Island's lamps use (150 units, 15 studs; 6 of our units).
+constexpr float kBrsDefaultLightRadius = 150.f;
+
 /// What a .brs file turned into.
 struct BrsLoadResult {
   std::vector<Brick> bricks;                      ///< bricks with collision on, in our units
@@ -144,6 +176,14 @@ struct BrsLoadResult {
   std::string mapName, author, description;       ///< from header 1
   std::vector<std::string> assetNames;            ///< header 2 brick asset table
   std::vector<BrsBrickRecord> records;            ///< every record, in file order
+  std::map<std::string, uint32_t> componentCounts;  ///< bricks per component name
+  /// Lights of the BCD_PointLight and BCD_SpotLight components, in file order (component by
+  /// component, its bricks as listed), grid-local in our units.
+  std::vector<BuildLight> lights;
+  std::vector<uint32_t> lightRecords;             ///< per light: index into records of its brick
+  /// Bricks carrying a component named "...Light" (found); lights.size() of them were used. The
+  /// two differ when a save has a light component we do not know.
+  uint32_t lightComponentsFound = 0;
 };
 
 /// Reads and converts a .brs file. Throws InvalidInput naming the file and the problem.

@@ -1,7 +1,8 @@
 // `brickworld inspect FILE`: load a content file and print what it became. A .brs save goes into
-// a brick grid (counts per asset and per shape, bounds, the OctoBVH's shape and memory, so the
-// real builds can be compared with the seeded generators); a .vox model goes into a voxel terrain
-// (models, voxel counts per palette index, water, bounds, chunk and broadphase counts).
+// a brick grid (counts per asset, per shape and per component, its lights, bounds, the OctoBVH's
+// shape and memory, so the real builds can be compared with the seeded generators); a .vox model
+// goes into a voxel terrain (models, voxel counts per palette index, water, bounds, chunk and
+// broadphase counts).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -49,6 +50,8 @@ int inspectBrs(const std::string& path, bool json) {
   const double forcedShare = shape.innerNodes ? double(shape.forcedNodes) / double(shape.innerNodes) : 0.0;
   const Aabb bounds = save.bounds;
   const bool hasBounds = !bounds.isEmpty();
+  uint32_t pointLights = 0, spotLights = 0;
+  for (const BuildLight& l : save.lights) (l.kind == BuildLightKind::Spot ? spotLights : pointLights) += 1;
 
   if (json) {
     nlohmann::json j;
@@ -64,6 +67,11 @@ int inspectBrs(const std::string& path, bool json) {
     j["unknown_assets"] = save.unknownAssets;
     j["assets"] = save.assetCounts;
     j["shapes"] = save.shapeCounts;
+    j["components"] = save.componentCounts;
+    j["lights"] = {{"point", pointLights},
+                   {"spot", spotLights},
+                   {"total", save.lights.size()},
+                   {"light_components_found", save.lightComponentsFound}};
     if (hasBounds) {
       j["bounds_min"] = {bounds.min.x(), bounds.min.y(), bounds.min.z()};
       j["bounds_max"] = {bounds.max.x(), bounds.max.y(), bounds.max.z()};
@@ -95,6 +103,10 @@ int inspectBrs(const std::string& path, bool json) {
                 bounds.extent().y(), bounds.extent().z());
   std::printf("  per shape\n");
   for (const auto& [name, n] : save.shapeCounts) std::printf("    %-34s %8u\n", name.c_str(), n);
+  std::printf("  lights      %zu (%u point, %u spot) of %u bricks with a light component\n", save.lights.size(),
+              pointLights, spotLights, save.lightComponentsFound);
+  std::printf("  per component\n");
+  for (const auto& [name, n] : save.componentCounts) std::printf("    %-34s %8u\n", name.c_str(), n);
   std::printf("  per asset\n");
   std::vector<std::pair<std::string, uint32_t>> assets(save.assetCounts.begin(), save.assetCounts.end());
   std::stable_sort(assets.begin(), assets.end(), [](const auto& a, const auto& b) { return a.second > b.second; });

@@ -16,29 +16,13 @@
 #include "collision/bricks/brick_geometry.h"
 #include "collision/bricks/brick_grid.h"
 #include "collision/content/brs_reader.h"
+#include "collision/content/brs_test_files.h"
 #include "collision/core/argument_checks.h"
 
 namespace bw {
 namespace {
 
-// The shared data folder is a sibling of the repository: <repo>/../shared/data.
-std::filesystem::path lighthousePath() {
-  namespace fs = std::filesystem;
-  const fs::path repo = fs::path(__FILE__).parent_path().parent_path().parent_path().parent_path();
-  const fs::path candidate = repo / ".." / "shared" / "data" / "Lighthouse_Island.brs";
-  if (fs::exists(candidate)) return candidate;
-  for (fs::path dir = fs::current_path(); !dir.empty(); dir = dir.parent_path()) {
-    const fs::path p = dir / ".." / "shared" / "data" / "Lighthouse_Island.brs";
-    if (fs::exists(p)) return p;
-    if (dir == dir.parent_path()) break;
-  }
-  return candidate;
-}
-
-std::vector<uint8_t> readFile(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using namespace test::brsfile;
 
 // Loaded once: the suite parses the 1.3 MB file many times already.
 const BrsLoadResult& lighthouse() {
@@ -213,168 +197,7 @@ TEST(BrsOrientation, DefaultIsIdentityAndAllTwentyFourAreDistinct) {
   EXPECT_THROW(brsOrientation(6, 0), InvalidInput);
 }
 
-// ---- hand-built saves ----
-
-// Writes bits least significant first, like the game.
-struct BitWriter {
-  std::vector<uint8_t> bytes;
-  uint64_t bit = 0;
-  void put(bool v) {
-    if ((bit >> 3) >= bytes.size()) bytes.push_back(0);
-    if (v) bytes[size_t(bit >> 3)] |= uint8_t(1u << (bit & 7));
-    ++bit;
-  }
-  void bits(uint64_t v, int n) {
-    for (int i = 0; i < n; ++i) put((v >> i) & 1);
-  }
-  void align() { bit = (bit + 7) & ~uint64_t(7); }
-  void uintBelow(uint64_t v, uint64_t max) {
-    uint64_t value = 0;
-    for (uint64_t mask = 1; value + mask < max; mask <<= 1) {
-      put(v & mask);
-      if (v & mask) value |= mask;
-    }
-  }
-  void packed(uint64_t v) {
-    do {
-      const uint64_t part = v & 127;
-      v >>= 7;
-      put(v != 0);
-      bits(part, 7);
-    } while (v != 0);
-  }
-  void signedPacked(int64_t v) { packed((uint64_t(v < 0 ? -v : v) << 1) | (v >= 0 ? 1 : 0)); }
-};
-
-struct Bytes {
-  std::vector<uint8_t> b;
-  void u8(uint8_t v) { b.push_back(v); }
-  void i32(int32_t v) {
-    for (int i = 0; i < 4; ++i) b.push_back(uint8_t(uint32_t(v) >> (8 * i)));
-  }
-  void str(const std::string& s) {
-    i32(int32_t(s.size() + 1));
-    b.insert(b.end(), s.begin(), s.end());
-    b.push_back(0);
-  }
-  void zeros(size_t n) { b.insert(b.end(), n, 0); }
-  void append(const std::vector<uint8_t>& o) { b.insert(b.end(), o.begin(), o.end()); }
-  // A section, zlib-compressed when that makes it smaller (as the game writes them).
-  void section(const std::vector<uint8_t>& raw) {
-    std::vector<uint8_t> z(compressBound(uLong(raw.size())));
-    uLongf zn = uLongf(z.size());
-    compress(z.data(), &zn, raw.data(), uLong(raw.size()));
-    i32(int32_t(raw.size()));
-    if (zn < raw.size()) {
-      i32(int32_t(zn));
-      b.insert(b.end(), z.begin(), z.begin() + long(zn));
-    } else {
-      i32(0);
-      append(raw);
-    }
-  }
-};
-
-struct TestBrick {
-  uint32_t asset;
-  bool hasSize;
-  uint32_t size[3];
-  int32_t pos[3];
-  int direction, rotation;
-  bool collision;
-};
-
-std::vector<uint8_t> buildSave(int version, const std::vector<std::string>& assets, const std::vector<TestBrick>& bricks,
-                               int32_t brickCountOverride = -1) {
-  Bytes f;
-  f.b = {'B', 'R', 'S'};
-  f.u8(uint8_t(version));
-  f.u8(0);
-  f.i32(1234);
-  Bytes h1;
-  h1.str("TestMap");
-  h1.str("Tester");
-  h1.str("a save built by the test");
-  h1.zeros(16);
-  h1.str("Host");
-  h1.zeros(16);
-  h1.zeros(8);
-  h1.i32(brickCountOverride >= 0 ? brickCountOverride : int32_t(bricks.size()));
-  f.section(h1.b);
-  Bytes h2;
-  h2.i32(0);  // mods
-  h2.i32(int32_t(assets.size()));
-  for (const auto& a : assets) h2.str(a);
-  h2.i32(3);  // colors
-  h2.zeros(12);
-  h2.i32(2);  // materials
-  h2.str("BMC_Plastic");
-  h2.str("BMC_Glow");
-  h2.i32(1);  // owners
-  h2.zeros(16);
-  h2.str("Tester");
-  h2.i32(int32_t(bricks.size()));
-  if (version >= 9) {
-    h2.i32(1);
-    h2.str("BPMC_Default");
-  }
-  f.section(h2.b);
-  f.u8(0);  // no preview
-  BitWriter w;
-  for (size_t i = 0; i < bricks.size(); ++i) {
-    const TestBrick& t = bricks[i];
-    w.align();
-    w.uintBelow(t.asset, std::max<uint64_t>(assets.size(), 2));
-    w.put(t.hasSize);
-    if (t.hasSize)
-      for (uint32_t s : t.size) w.packed(s);
-    for (int32_t p : t.pos) w.signedPacked(p);
-    w.uintBelow(uint64_t(t.direction * 4 + t.rotation), 24);
-    if (version >= 10) {
-      w.put(t.collision);
-      w.bits(0b111, 3);  // weapon, interaction, tool on: only the player bit decides
-    } else {
-      w.put(t.collision);
-    }
-    w.put(true);           // visible
-    w.uintBelow(1, 2);     // material
-    if (version >= 9) {
-      w.uintBelow(0, 2);   // physical material
-      w.uintBelow(5, 11);  // intensity
-    }
-    if (i % 2) {
-      w.put(true);
-      w.bits(0x00ABCDEF, version >= 9 ? 24 : 32);
-    } else {
-      w.put(false);
-      w.uintBelow(2, 3);
-    }
-    w.packed(1);  // owner 0
-  }
-  f.section(w.bytes);
-  Bytes comps;
-  comps.i32(1);
-  comps.str("BCD_Test");
-  comps.i32(3);
-  comps.zeros(3);
-  f.section(comps.b);
-  return f.b;
-}
-
-const std::vector<std::string> kAssets = {"PB_DefaultBrick", "PB_DefaultSideWedgeTile", "B_1x1_Round", "B_Mystery",
-                                          "PB_DefaultArch", "PB_DefaultWedge"};
-
-std::vector<TestBrick> sampleBricks() {
-  return {
-      {0, true, {10, 20, 6}, {0, 0, 6}, 4, 0, true},           // 2x4 brick, default orientation
-      {1, true, {15, 5, 2}, {-100, 40, 2}, 4, 1, true},        // side wedge tile, quarter turn
-      {2, false, {0, 0, 0}, {50, -50, 18}, 0, 2, true},        // round 1x1 lying along +X
-      {3, false, {0, 0, 0}, {7, 8, 9}, 5, 3, true},            // unknown fixed asset
-      {4, true, {5, 30, 12}, {0, 300, 12}, 2, 0, true},        // unknown procedural asset
-      {5, true, {20, 10, 12}, {1000, 0, -12}, 1, 1, false},    // wedge, collision off
-      {0, true, {1, 1, 1}, {-70000, 123456, -999}, 3, 2, true},
-  };
-}
+// ---- hand-built saves (brs_test_files.h) ----
 
 TEST(BrsSynthetic, VersionsEightToTenReadTheSameBricks) {
   for (int version : {8, 9, 10}) {
@@ -435,20 +258,6 @@ TEST(BrsSynthetic, EmptySaveLoads) {
   EXPECT_EQ(r.totalBricks, 0u);
   EXPECT_TRUE(r.bricks.empty());
   EXPECT_TRUE(r.bounds.isEmpty());
-}
-
-// Parses a copy of exactly `bytes` (so ASan sees any over-read) and expects a clear failure.
-void expectInvalid(const std::vector<uint8_t>& bytes, const std::string& name, const std::string& fragment) {
-  std::vector<uint8_t> exact(bytes);
-  exact.shrink_to_fit();
-  try {
-    parseBrs(exact.empty() ? nullptr : exact.data(), exact.size(), name);
-    ADD_FAILURE() << name << ": expected InvalidInput containing \"" << fragment << "\"";
-  } catch (const InvalidInput& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(name), std::string::npos) << msg;
-    EXPECT_NE(msg.find(fragment), std::string::npos) << msg;
-  }
 }
 
 TEST(BrsBadFiles, EmptyWrongMagicAndVersion) {
