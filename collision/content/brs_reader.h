@@ -60,17 +60,20 @@
 ///              Rotator 3 floats (pitch, yaw, roll, degrees)   Class, Object, String: a string
 ///              (and, from public readers, not seen in a save we have: Integer 32 bits,
 ///              Integer64 64 bits, Double 64 bits, IntVector 3 x 32 bits)
-/// padding      zero bits up to the next byte: the values end in the component's last byte
-///              (Lighthouse_Island: 1 and 4 bits); 8 or more bits left over is an error
+/// padding      up to the next byte: the values end in the component's last byte (Lighthouse_Island:
+///              1 and 4 zero bits; their values are not checked); 8 or more bits left is an error
 /// ```
-/// Any other type cannot be sized, so the component cannot be decoded: an error naming it.
-/// Properties used: BCD_PointLight (bMatchBrickShape Boolean, Brightness Float, Radius Float,
-/// Color Color, bUseBrickColor Boolean, bCastShadows Boolean) and BCD_SpotLight (Rotation
-/// Rotator, InnerConeAngle Float, OuterConeAngle Float, Brightness, Radius, Color,
-/// bUseBrickColor, bCastShadows) each give a BuildLight at its brick's centre (collision on or
-/// off: a lamp's glass often has none) with Radius in Brickadia units times unitsPerBrsUnit;
-/// a missing or non-positive Radius gives kBrsDefaultLightRadius, a NaN or infinite one is an
-/// error.
+/// Any other type cannot be sized, so the component cannot be decoded: an error naming it. The
+/// section ends with its last component (bytes after it are an error).
+///
+/// Lights: every brick listed by BCD_PointLight (properties in Lighthouse_Island:
+/// bMatchBrickShape Boolean, Brightness Float, Radius Float, Color Color, bUseBrickColor
+/// Boolean, bCastShadows Boolean) or BCD_SpotLight (Rotation Rotator, InnerConeAngle Float,
+/// OuterConeAngle Float, then the point light's Brightness to bCastShadows without
+/// bMatchBrickShape) gives a BuildLight at its brick's centre, collision on or off (a lamp's
+/// glass often has none). Its radius is the Radius property in Brickadia units times
+/// unitsPerBrsUnit; a missing or non-positive Radius gives kBrsDefaultLightRadius, a NaN or
+/// infinite one is an error. Only the position, radius and kind are kept.
 ///
 /// ## Units and frame
 /// Brickadia units: 10 per stud across, 4 per plate of height (a brick is 12); `size` is a half

@@ -11,6 +11,12 @@
 /// so they touch but do not overlap. The output vector is sized exactly before it is filled:
 /// each generator runs once to count, reserves, then runs again to write.
 ///
+/// Lights: each build also lists the lights a game would give it (ceiling lamps, head lights,
+/// running lights, street lamps; see each generator), placed in open space (never inside a
+/// brick's box), with radii of 4 to 15 units, also a pure function of (seed, scale). They are
+/// derived from the build's dimensions and its existing random draws only, so adding them left
+/// every brick unchanged.
+///
 /// Scale law: for every build the brick count grows about linearly with `scale`. Shell builds
 /// (house, truck, carrier, ring station) grow their linear dimensions with sqrt(scale), the plate
 /// stack adds plates, the city block adds lots, ramps and microbrick patches.
@@ -28,6 +34,7 @@
 #include <vector>
 
 #include "collision/bricks/brick.h"
+#include "collision/content/build_light.h"
 #include "collision/core/aabb.h"
 
 namespace bw {
@@ -69,17 +76,23 @@ struct GeneratedBuild {
   std::vector<BuildPart> parts;
   /// Set by the ring station only.
   RingDimensions ring;
+  /// Lights of the build (grid-local, in open space), in generation order.
+  std::vector<BuildLight> lights;
 };
 
 /// A house of round(1.8 * sqrt(scale)) storeys (at least one; two at scale 1): baseplates, floor plates, running-bond
 /// brick walls with window and door holes, a partition wall per storey, furniture of small
 /// bricks, a hip roof of wedges with corner wedges, porch pillars (cylinders).
+/// Lights: ceiling lamps in every room of every storey (one per ~8 x 8 units of room, at least
+/// one) and a porch lamp under the porch roof (5 at scale 1).
 /// Throws InvalidInput naming `scale` unless 0.25 <= scale <= 64.
 GeneratedBuild generateHouse(uint64_t seed, float scale);
 
 /// A truck: frame rails and deck, cylinder wheels on horizontal (Y) axles, a cab with
 /// windows, seats and a wedge fairing, and an open bed (floor + low side walls + tailgate,
 /// nothing above it). interiors[0] is the bed's open space, up to 2 units above its walls.
+/// Lights: two head lights (Spot) in front of the headlight bricks and two tail lights behind
+/// the tailgate (4 at every scale).
 /// Throws InvalidInput naming `scale` unless 0.25 <= scale <= 64.
 GeneratedBuild generateTruck(uint64_t seed, float scale);
 
@@ -87,17 +100,22 @@ GeneratedBuild generateTruck(uint64_t seed, float scale);
 /// bulkheads, an enclosed hangar (floor, walls, the flight deck as ceiling, a large opening
 /// in the starboard side), flight deck with markings and arresting wires, an island tower with
 /// a mast, parked aircraft. interiors[0] is the hangar's open space.
+/// Lights: running lights just outside both deck edges every ~16 units plus bow and stern
+/// lights, and a grid of hangar lights under the flight deck (56 at scale 1).
 /// Throws InvalidInput naming `scale` unless 0.04 <= scale <= 64.
 GeneratedBuild generateCarrierShip(uint64_t seed, float scale);
 
 /// A ring station around grid Z, pixelated on a 0.4 lattice (axis-aligned bricks only): floor
 /// cells facing the axis (their local +Z points at the axis), ceiling with windows, side walls,
 /// modules standing on the floor, a hub and four spokes. `ring` holds its dimensions.
+/// Lights: one per ~10 units of the ring (a multiple of 4, at least 8) in the band just under
+/// the ceiling that modules never reach, at z = 0 (44 at scale 1).
 /// Throws InvalidInput naming `scale` unless 0.01 <= scale <= 64.
 GeneratedBuild generateRingStation(uint64_t seed, float scale);
 
 /// The article's worst case for loose octrees: round(300 * scale) (at least 3) large flat
 /// plates (64 x 64 or 64 x 48, 0.16 thick) stacked on top of each other with small offsets.
+/// No lights.
 /// Throws InvalidInput naming `scale` unless 0.01 <= scale <= 64.
 GeneratedBuild generatePlateStackBricks(uint64_t seed, float scale);
 
@@ -105,6 +123,8 @@ GeneratedBuild generatePlateStackBricks(uint64_t seed, float scale);
 /// windows, floors, lobby pillars, flat or hip roofs), 500-long ramps (Wedge, half size
 /// (250, 4, 2)) and patches of 0.08 microbricks right next to the ramps.
 /// ~2M bricks at scale 1, ~20k at scale 0.01; the ramps stay 500 long at every scale.
+/// Lights: a lamp in each building's ground-floor lobby, and street lamps 4.5 above the street
+/// centre lines every 20 units (835 at scale 1, 61 at scale 0.05).
 /// Throws InvalidInput naming `scale` unless 0.001 <= scale <= 8.
 GeneratedBuild generateCityBlock(uint64_t seed, float scale);
 

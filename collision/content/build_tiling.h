@@ -10,13 +10,15 @@
 /// tile (0, 0) is the input itself. Output order is tile by tile (i fastest), each tile in input
 /// order, so brick k of tile (i, j) is at index (j * tilesX + i) * bricks.size() + k.
 /// Offsets are added in double and rounded once to float, so every tile's bricks sit exactly
-/// where a direct placement at that offset would put them.
+/// where a direct placement at that offset would put them. tileLights() moves a build's lights
+/// by exactly the same offsets in the same order, so lights stay on their tile's bricks.
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "collision/bricks/brick.h"
+#include "collision/content/build_light.h"
 #include "collision/core/aabb.h"
 
 namespace bw {
@@ -32,6 +34,12 @@ constexpr int kMaxTilesPerAxis = 4096;
 /// the brick count would exceed kMaxTiledBricks, or a tiled brick would leave the grid-local
 /// coordinate range (+-2^30). Nothing is allocated before the checks pass.
 std::vector<Brick> tileBuild(std::span<const Brick> bricks, const Aabb& bounds, int tilesX, int tilesY, float gap);
+
+/// The lights of the build tileBuild() tiled: light k of tile (i, j) is at index
+/// (j * tilesX + i) * lights.size() + k, moved by that tile's offset (the same double sum,
+/// rounded once). `bounds` are the bricks' bounds, the ones given to tileBuild(). Throws
+/// InvalidInput like tileBuild() (with kMaxTiledBricks as the light limit); no lights, no output.
+std::vector<BuildLight> tileLights(std::span<const BuildLight> lights, const Aabb& bounds, int tilesX, int tilesY, float gap);
 
 /// Tiles per axis n (1..kMaxTilesPerAxis) such that n * n * bricksPerTile is closest to target
 /// (ties go to the smaller n). Throws InvalidInput when bricksPerTile or target is 0.

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "collision/core/argument_checks.h"
+#include "collision/core/assert.h"
 
 namespace bw::buildgen {
 
@@ -132,6 +134,30 @@ void perimeterWalls(BuildWriter& w, std::vector<Aabb>& holes, float x0, float x1
     if (door) holes.push_back(*door);
     wall(w, wl[0], wl[1], brickLength, brickHeight, material, holes);
   }
+}
+
+Vec3f circlePoint(int k, int n) {
+  BW_ASSERT(n > 0 && n % 4 == 0);
+  const int quarter = n / 4;
+  k = ((k % n) + n) % n;
+  const int turns = k / quarter, j = k % quarter;
+  // Past an eighth of a turn, use the complement: cos(a) = sin(pi/2 - a).
+  const bool mirror = 2 * j > quarter;
+  const double a = double(mirror ? quarter - j : j) * (1.5707963267948966 / double(quarter));
+  // note: |a| <= pi/4, where the terms to a^17 / 17! leave an error below 1e-16.
+  double c = 0.0, s = 0.0, term = 1.0;
+  for (int i = 0; i < 18; ++i) {
+    if (i % 2 == 0) c += (i % 4 == 0) ? term : -term;
+    else s += (i % 4 == 1) ? term : -term;
+    term *= a / double(i + 1);
+  }
+  if (mirror) std::swap(c, s);
+  for (int t = 0; t < turns; ++t) {  // a quarter turn: (x, y) -> (-y, x), exact
+    const double x = c;
+    c = -s;
+    s = x;
+  }
+  return Vec3f(float(c), float(s), 0.f);
 }
 
 void computeBounds(GeneratedBuild& b) {

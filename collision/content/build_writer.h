@@ -1,7 +1,8 @@
 #pragma once
 /// What the seeded build generators share (internal to collision/content/): brick dimensions,
-/// the BuildWriter that collects bricks into parts, and the building blocks every generator
-/// uses (tiled boxes, running-bond walls, hip roofs, windows, perimeter walls).
+/// the BuildWriter that collects bricks into parts (and the build's lights), and the building
+/// blocks every generator uses (tiled boxes, running-bond walls, hip roofs, windows, perimeter
+/// walls, points on a circle).
 #include <optional>
 #include <span>
 #include <vector>
@@ -34,6 +35,7 @@ class BuildWriter {
   explicit BuildWriter(GeneratedBuild* out) : out_(out) {}
 
   uint32_t count() const { return count_; }
+  uint32_t lightCount() const { return lightCount_; }
 
   // Starts a named part; every brick added from now on belongs to it.
   void part(const char* name, uint32_t filter = kBuildFilterStructure) {
@@ -49,6 +51,11 @@ class BuildWriter {
   }
   void ring(const RingDimensions& r) {
     if (out_) out_->ring = r;
+  }
+  // A light in open space; radius in our units.
+  void light(const Vec3f& position, float radius, BuildLightKind kind = BuildLightKind::Point) {
+    ++lightCount_;
+    if (out_) out_->lights.push_back(BuildLight{position, radius, kind});
   }
 
   // `worldHalf` is the half extent in the grid; the brick's own half size is derived from the
@@ -86,6 +93,7 @@ class BuildWriter {
   }
   GeneratedBuild* out_;
   uint32_t count_ = 0;
+  uint32_t lightCount_ = 0;
   uint32_t filter_ = kBuildFilterStructure;
 };
 
@@ -113,6 +121,10 @@ void addWindows(std::vector<Aabb>& holes, const Vec3f& lo, const Vec3f& hi, floa
 void perimeterWalls(BuildWriter& w, std::vector<Aabb>& holes, float x0, float x1, float y0, float y1, float z0, float z1,
                     float brickLength, float brickHeight, BuildMaterial material, float pitch, float winZ0, float winZ1,
                     const std::optional<Aabb>& door);
+// Point k of n (n a positive multiple of 4) evenly spaced on the unit circle, counter-clockwise
+// from +X: (cos, sin) of 2 pi k / n. Computed with + - * / only (quarter turns are exact, the
+// rest a Taylor series on at most an eighth of a turn), so every platform gets the same bits.
+Vec3f circlePoint(int k, int n);
 // The bounds of the build's bricks.
 void computeBounds(GeneratedBuild& b);
 // Throws InvalidInput unless lo <= scale <= hi (a generator's accepted scales).
@@ -125,6 +137,7 @@ GeneratedBuild runBuild(const char* name, Body&& body) {
   GeneratedBuild out;
   out.name = name;
   out.bricks.reserve(counter.count());
+  out.lights.reserve(counter.lightCount());
   BuildWriter writer(&out);
   body(writer);
   writer.finish();

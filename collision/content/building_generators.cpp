@@ -125,6 +125,16 @@ class FurniturePlacer {
 
 // ---------------------------------------------------------------------------------- house
 
+// Lamps on a room's ceiling at height z: one per ~8 x 8 units of floor [x0, x1] x [y0, y1], at
+// the centres of an even grid (so they stay clear of the walls around the room).
+void ceilingLamps(BuildWriter& w, float x0, float x1, float y0, float y1, float z) {
+  const int nx = std::max(1, int(std::lround((x1 - x0) / 8.f))), ny = std::max(1, int(std::lround((y1 - y0) / 8.f)));
+  const float cx = (x1 - x0) / float(nx), cy = (y1 - y0) / float(ny);
+  const float radius = std::clamp(0.75f * std::max(cx, cy), 4.f, 15.f);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) w.light(Vec3f(x0 + (float(i) + 0.5f) * cx, y0 + (float(j) + 0.5f) * cy, z), radius);
+}
+
 void houseBody(BuildWriter& w, uint64_t seed, float scale) {
   SeededRandom rng(seed);
   const float s = std::sqrt(scale);
@@ -165,6 +175,9 @@ void houseBody(BuildWriter& w, uint64_t seed, float scale) {
     a.furnish(w, rng, std::max(1, roomA * rows / 8));
     FurniturePlacer b(partitionX + kStud, kStud, roomB, rows, floorTop);
     b.furnish(w, rng, std::max(1, roomB * rows / 8));
+    // Ceiling lamps 0.3 below the next floor, well above the tallest furniture (2.1 above the floor).
+    ceilingLamps(w, kStud, partitionX, kStud, depth - kStud, z1 - 0.3f);
+    ceilingLamps(w, partitionX + kStud, width - kStud, kStud, depth - kStud, z1 - 0.3f);
   }
   const float top = float(storeys) * storeyH;
   w.part("ceiling");
@@ -177,6 +190,8 @@ void houseBody(BuildWriter& w, uint64_t seed, float scale) {
   for (float dx : {-1.f, 1.f}) w.addPillar(Vec3f(doorX + dx * 1.f, -0.8f, 0.f), 0.2f, porchH, BuildMaterial::Concrete);
   tile(w, Vec3f(doorX - 1.6f, -1.6f, porchH), Vec3f(doorX + 1.6f, 0.f, porchH + kPlateHeight), Vec3f(0.8f, 0.8f, kPlateHeight),
        BuildMaterial::Wood);
+  // Porch lamp under the porch roof, between the pillars.
+  w.light(Vec3f(doorX, -0.8f, porchH - 0.3f), 4.f);
 }
 
 // ---------------------------------------------------------------------------------- plate stack
@@ -216,6 +231,11 @@ void cityBuilding(BuildWriter& w, SeededRandom& rng, std::vector<Aabb>& holes, f
       for (float x = x0 + 3.2f; x < x1 - 2.4f; x += 4.8f)
         for (float y = y0 + 3.2f; y < y1 - 2.4f; y += 4.8f)
           w.addPillar(Vec3f(x, y, z0 + kPlateHeight), 0.2f, storeyH - kPlateHeight, BuildMaterial::Concrete);
+      // The lobby lamp: in the middle of the pillar-grid cell nearest the centre (2.4 from the
+      // pillars around it), 0.4 below the next floor.
+      const float cellX = 4.8f * float(int((x1 - x0) * 0.5f / 4.8f)), cellY = 4.8f * float(int((y1 - y0) * 0.5f / 4.8f));
+      w.light(Vec3f(x0 + 0.8f + cellX, y0 + 0.8f + cellY, z0 + storeyH - 0.4f),
+              std::clamp(0.5f * std::max(x1 - x0, y1 - y0), 4.f, 15.f));
     }
   }
   const float top = float(storeys) * storeyH;
@@ -266,6 +286,13 @@ void cityBody(BuildWriter& w, uint64_t seed, float scale) {
     const float ox = lx + snap((lotSize - bx) * 0.5f, 0.8f, 0.f), oy = ly + snap((lotSize - by) * 0.5f, 0.8f, 0.f);
     cityBuilding(w, rng, holes, ox, ox + bx, oy, oy + by, storeys);
   }
+
+  // Street lamps 4.5 above the street centre lines (x = 40 i, y = 40 j; buildings keep 4 away
+  // from them, the ramps and patches stay below y = 0 and 4 high) every 20 units.
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= 2 * nx; ++i) w.light(Vec3f(float(i) * pitch * 0.5f, float(j) * pitch, 4.5f), 10.f);
+  for (int i = 0; i <= nx; ++i)
+    for (int j = 0; j < ny; ++j) w.light(Vec3f(float(i) * pitch, (float(j) + 0.5f) * pitch, 4.5f), 10.f);
 
   auto rampOrigin = [&](int r) {
     const float x = float(r % rampsPerLane) * rampSlot + 10.f, y = yMin + float(r / rampsPerLane) * laneWidth + 1.f;

@@ -107,6 +107,13 @@ void ringBody(BuildWriter& w, uint64_t seed, float scale) {
                 BuildMaterial::Plastic, BrickShape::Box, up);
       }
   }
+  // Lights around the ring at z = 0, one per ~10 units, at radius ceilOut + c: ceiling cells
+  // (centres inside ceilOut) reach at most c / sqrt(2) = 0.28 past it and modules stop at least
+  // 2c - 0.28 short of it, so every light has 0.1 of open space on each side.
+  const float lightR = ceilOut + c;
+  const int lights = 4 * std::max(2, int(std::lround(lightR * 6.2831853f / 40.f)));
+  const float lightRadius = std::clamp(lightR * 6.2831853f / float(lights), 4.f, 15.f);
+  for (int k = 0; k < lights; ++k) w.light(circlePoint(k, lights) * lightR, lightRadius);
   w.part("hub");
   for (int k = 0; k < zSegs; ++k)
     w.add(Vec3f(0, 0, z0 + (float(k) + 0.5f) * zStep), Vec3f(hubR, hubR, zStep * 0.5f), BuildMaterial::Metal,

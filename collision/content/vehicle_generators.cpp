@@ -129,6 +129,13 @@ void truckBody(BuildWriter& w, uint64_t seed, float scale) {
   const Vec3f bedLo(kStud, -hw + kStud, deckTop), bedHi(bedEnd, hw - kStud, deckTop + kMicro);
   tile(w, bedLo, bedHi, Vec3f(kStud, 0.2f, kMicro), BuildMaterial::Wood);
   w.interior(Aabb{Vec3f(bedLo.x(), bedLo.y(), bedHi.z()), Vec3f(bedHi.x(), bedHi.y(), deckTop + bedWallH + 2.f)});
+
+  // Head lights 0.22 in front of the headlight bricks (which end 0.08 past the cab; the bumper
+  // below reaches 0.4 but stops under the deck), tail lights 0.3 behind the tailgate.
+  for (float side : {-1.f, 1.f}) {
+    w.light(Vec3f(length + 0.3f, side * (hw - 0.4f), deckTop + 0.3f), std::clamp(12.f * s, 4.f, 15.f), BuildLightKind::Spot);
+    w.light(Vec3f(-0.3f, side * (hw - 0.4f), deckTop + 0.2f), 4.f);
+  }
 }
 
 // ---------------------------------------------------------------------------------- carrier
@@ -263,6 +270,27 @@ void carrierBody(BuildWriter& w, uint64_t seed, float scale) {
     for (float y = 2.f; y + 5.6f < beam && placed < planes; y += 6.4f, ++placed) aircraft(w, rng, Vec3f(x, y + 2.8f, deckTop));
   for (float x = ix1 + 1.6f; x + 8.f < deckEnd && placed < planes; x += 8.f)
     for (float y = 2.f; y + 5.6f < beam && placed < planes; y += 6.4f, ++placed) aircraft(w, rng, Vec3f(x, y + 2.8f, deckTop));
+
+  // Running lights 0.2 outside both deck edges and 0.2 above the deck (clear of the sponson,
+  // which ends at the deck's top, and of the island, which ends at the starboard edge) every
+  // ~16 units, with a bow and a stern light.
+  const float runZ = deckTop + 0.2f;
+  const int runs = std::max(2, int(std::lround(deckEnd / 16.f)));
+  for (int k = 0; k < runs; ++k) {
+    const float x = (float(k) + 0.5f) * deckEnd / float(runs);
+    w.light(Vec3f(x, -0.2f, runZ), 4.f);
+    w.light(Vec3f(x, beam + 0.2f, runZ), 4.f);
+  }
+  w.light(Vec3f(deckEnd + 0.3f, beam * 0.5f, runZ), 4.f);
+  w.light(Vec3f(-0.3f, beam * 0.5f, runZ), 4.f);
+  // Hangar lights 0.5 under the flight deck, one per ~12 x 16 units of the (empty) hangar.
+  const int hangarX = std::max(1, int(std::lround((hx1 - hx0) / 12.f)));
+  const int hangarY = std::max(1, int(std::lround((innerY1 - innerY0) / 16.f)));
+  for (int j = 0; j < hangarY; ++j)
+    for (int i = 0; i < hangarX; ++i)
+      w.light(Vec3f(hx0 + (float(i) + 0.5f) * (hx1 - hx0) / float(hangarX),
+                    innerY0 + (float(j) + 0.5f) * (innerY1 - innerY0) / float(hangarY), flightDeck - 0.5f),
+              10.f);
 }
 
 }  // namespace
