@@ -12,6 +12,11 @@ namespace bw {
 struct Profiler::ThreadBuffer {
   uint32_t thread;
   std::vector<ProfileEvent> events;
+  // Where each run of one frame's events starts: {frame, first event}. Frames arrive in
+  // ascending order from a world, so workSpan(frame) finds its events by binary search
+  // (O(events of that frame)); a buffer that ever went back to an earlier frame is scanned whole.
+  std::vector<std::pair<uint32_t, size_t>> frameStarts;
+  bool framesAscending = true;
 };
 
 namespace {
@@ -43,9 +48,13 @@ Profiler::ThreadBuffer& Profiler::bufferForThisThread() {
   return b;
 }
 
-void Profiler::record(const char* name, int64_t beginNs, int64_t endNs, int32_t stage) {
+void Profiler::record(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, bool serial) {
   ThreadBuffer& b = bufferForThisThread();
-  b.events.push_back({name, beginNs, endNs, b.thread, stage, frame_});
+  if (b.frameStarts.empty() || b.frameStarts.back().first != frame_) {
+    if (!b.frameStarts.empty() && b.frameStarts.back().first > frame_) b.framesAscending = false;
+    b.frameStarts.push_back({frame_, b.events.size()});
+  }
+  b.events.push_back({name, beginNs, endNs, b.thread, stage, frame_, serial});
 }
 
 std::vector<ProfileEvent> Profiler::events() const {
@@ -62,7 +71,11 @@ std::vector<ProfileEvent> Profiler::events() const {
 
 void Profiler::clear() {
   std::lock_guard<std::mutex> lock(registry_);
-  for (auto& b : buffers_) b->events.clear();
+  for (auto& b : buffers_) {
+    b->events.clear();
+    b->frameStarts.clear();
+    b->framesAscending = true;
+  }
 }
 
 double WorkSpan::boundMs(int threads) const {
@@ -77,22 +90,28 @@ double WorkSpan::speedupBound(int threads) const {
 }
 
 namespace {
-using StageTimes = std::map<int32_t, std::pair<double, double>>;  // stage -> (work, longest job)
+struct StageTime {
+  double work = 0, longest = 0, serial = 0;  // ms: all zones, the longest zone, the serial zones
+};
+using StageTimes = std::map<int32_t, StageTime>;
 
 void addZone(StageTimes& stages, const ProfileEvent& e) {
   const double ms = double(e.endNs - e.beginNs) * 1e-6;
-  auto& s = stages[e.stage];
-  s.first += ms;
-  s.second = std::max(s.second, ms);
+  StageTime& s = stages[e.stage];
+  s.work += ms;
+  s.longest = std::max(s.longest, ms);
+  if (e.serial) s.serial += ms;
 }
 
 WorkSpan toWorkSpan(const StageTimes& stages) {
   WorkSpan ws;
   for (const auto& [stage, s] : stages) {
-    ws.workMs += s.first;
-    ws.spanMs += s.second;
-    ws.stageWorkMs.push_back(s.first);
-    ws.stageSpanMs.push_back(s.second);
+    const double span = std::max(s.longest, s.serial);
+    ws.workMs += s.work;
+    ws.spanMs += span;
+    ws.stageWorkMs.push_back(s.work);
+    ws.stageSpanMs.push_back(span);
+    ws.stageIds.push_back(stage);
   }
   ws.stages = int(stages.size());
   return ws;
@@ -116,9 +135,21 @@ std::vector<WorkSpan> Profiler::workSpans(uint32_t frames) const {
 WorkSpan Profiler::workSpan(uint32_t frame) const {
   StageTimes stages;
   std::lock_guard<std::mutex> lock(registry_);
-  for (const auto& b : buffers_)
-    for (const ProfileEvent& e : b->events)
+  for (const auto& b : buffers_) {
+    size_t begin = 0, end = b->events.size();
+    if (b->framesAscending) {
+      const auto& starts = b->frameStarts;
+      const auto it = std::lower_bound(starts.begin(), starts.end(), frame,
+                                       [](const std::pair<uint32_t, size_t>& s, uint32_t f) { return s.first < f; });
+      if (it == starts.end() || it->first != frame) continue;
+      begin = it->second;
+      end = it + 1 == starts.end() ? b->events.size() : (it + 1)->second;
+    }
+    for (size_t k = begin; k < end; ++k) {
+      const ProfileEvent& e = b->events[k];
       if (e.frame == frame && e.stage >= 0) addZone(stages, e);
+    }
+  }
   return toWorkSpan(stages);
 }
 

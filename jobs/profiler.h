@@ -31,12 +31,16 @@ struct ProfileEvent {
   uint32_t thread;      ///< dense thread index (registration order)
   int32_t stage;        ///< frame stage, or -1 for zones outside the stage structure
   uint32_t frame;
+  bool serial = false;  ///< runs under a lock shared by every thread (see WorkSpan)
 };
 
 /// Work and span of one frame, from its job zones (those with stage >= 0).
 /// Stages run one after another; jobs inside a stage are independent. So the frame's critical
 /// path is the sum over stages of their longest job, and with p threads a stage takes at least
 /// max(work / p, longest job): the speedup bound at p threads is work / sum of those.
+/// Serial zones (work done under one lock every thread takes, like a mutex command queue's
+/// pushes) cannot overlap each other however many threads run, so a stage's span is at least
+/// the sum of its serial zones.
 struct WorkSpan {
   double workMs = 0;           ///< sum of all job durations
   double spanMs = 0;           ///< sum over stages of the longest job
@@ -44,6 +48,7 @@ struct WorkSpan {
   double boundMs(int threads) const;       ///< lower bound on the frame time with p threads
   double speedupBound(int threads) const;  ///< workMs / boundMs(p)
   std::vector<double> stageWorkMs, stageSpanMs;
+  std::vector<int32_t> stageIds;  ///< the stage id of each entry above, ascending
 };
 
 class Profiler {
@@ -65,12 +70,13 @@ class Profiler {
   int64_t now() const {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - epoch_).count();
   }
-  /// Appends a closed zone from the calling thread.
-  void record(const char* name, int64_t beginNs, int64_t endNs, int32_t stage);
+  /// Appends a closed zone from the calling thread (serial: see WorkSpan).
+  void record(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, bool serial = false);
 
   /// All recorded events, sorted by (begin, thread, end).
   std::vector<ProfileEvent> events() const;
-  /// Work/span of one frame's job zones.
+  /// Work/span of one frame's job zones, in O(events of that frame) when frames were recorded
+  /// in ascending order (a world's are).
   WorkSpan workSpan(uint32_t frame) const;
   /// Work/span of frames 0 .. frames-1 in one pass over the events (workSpan per frame would
   /// read every event once per frame).
@@ -96,10 +102,10 @@ class Profiler {
 /// RAII zone: records [construction, destruction) on the current thread.
 class ProfileZone {
  public:
-  ProfileZone(Profiler& p, const char* name, int32_t stage = -1)
-      : p_(p), name_(name), stage_(stage), begin_(p.enabled() ? p.now() : 0) {}
+  ProfileZone(Profiler& p, const char* name, int32_t stage = -1, bool serial = false)
+      : p_(p), name_(name), stage_(stage), serial_(serial), begin_(p.enabled() ? p.now() : 0) {}
   ~ProfileZone() {
-    if (p_.enabled()) p_.record(name_, begin_, p_.now(), stage_);
+    if (p_.enabled()) p_.record(name_, begin_, p_.now(), stage_, serial_);
   }
   ProfileZone(const ProfileZone&) = delete;
   ProfileZone& operator=(const ProfileZone&) = delete;
@@ -108,6 +114,7 @@ class ProfileZone {
   Profiler& p_;
   const char* name_;
   int32_t stage_;
+  bool serial_;
   int64_t begin_;
 };
 

@@ -11,6 +11,7 @@
 /// many appends were attempted and reports the overflow; there is never a write out of bounds.
 /// Reading: size() and the elements are valid for a thread that synchronised with every
 /// appender (e.g. after the parallelFor that appended joined). clear() only while no one appends.
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -40,6 +41,18 @@ class AtomicAppendArray {
     if (index >= slots_.size()) return false;
     slots_[index] = item;
     return true;
+  }
+
+  /// Appends count items with one fetch_add (a block reserves its slots at once, so 16 threads
+  /// appending blocks of 64 touch the shared counter 64 times less often); false when the block
+  /// did not fit, in which case only the items that fit are written and the overflow is counted.
+  bool tryAppend(const T* items, uint32_t count) noexcept {
+    if (count == 0) return true;
+    const uint64_t first = count_.value.fetch_add(count, std::memory_order_relaxed);
+    const uint64_t cap = slots_.size();
+    const uint64_t fit = first >= cap ? 0 : std::min<uint64_t>(count, cap - first);
+    for (uint64_t i = 0; i < fit; ++i) slots_[first + i] = items[i];
+    return fit == count;
   }
 
   /// Number of stored elements (at most capacity).

@@ -1,6 +1,6 @@
 #pragma once
 /// Batched submission: workers append records to a pre-sized atomic-append batch (one
-/// fetch_add each); the game thread hands the whole batch over as one command at frame end.
+/// fetch_add per record, or per block of records when the update hands over blocks); the game thread hands the whole batch over as one command at frame end.
 ///
 /// Two batches alternate: the render thread reads frame N's while workers fill frame N+1's.
 /// beginFrame(N) waits for frame N-2's fence before reusing its batch. Light moves send no
@@ -27,6 +27,10 @@ class BatchedSubmitter final : public TransformUpdateSink {
   void primitive(const PrimitiveUpdate& update) override { current_->primitives.tryAppend(update); }
   /// Same for lights (no radius refresh).
   void light(const LightUpdate& update) override { current_->lights.tryAppend(update); }
+  /// A worker's block of primitives: one fetch_add for the block.
+  void primitives(const PrimitiveUpdate* updates, uint32_t count) override { current_->primitives.tryAppend(updates, count); }
+  /// A worker's block of lights: one fetch_add for the block.
+  void lights(const LightUpdate* updates, uint32_t count) override { current_->lights.tryAppend(updates, count); }
 
   /// Prepares frame's batch (game thread, before the update); may wait for frame - 2.
   void beginFrame(uint64_t frame);

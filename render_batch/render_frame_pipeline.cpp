@@ -55,16 +55,24 @@ FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const Upda
   const auto start = std::chrono::steady_clock::now();
   // note: frame_ advances just before the commit, which always signals the fence (even when
   // it then throws on overflow); a throwing update leaves frame_ unchanged and nothing fenced.
+  // note: the commit's time is taken even when it throws (a batch overflow), by the guard.
+  struct CommitTimer {
+    FrameTiming& timing;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+    ~CommitTimer() { timing.commitMs = msSince(start); }
+  };
   if (batched_) {
     batched_->beginFrame(frame);
     TransformUpdate update(store_, bodies, *batched_);
     runner(update);
     frame_ = frame;
+    CommitTimer commit{timing};
     batched_->commitFrame(frame);
   } else {
     TransformUpdate update(store_, bodies, *perObject_);
     runner(update);
     frame_ = frame;
+    CommitTimer commit{timing};
     perObject_->commitFrame(frame);
   }
   timing.gameMs = msSince(start);

@@ -23,8 +23,9 @@ namespace bw {
 
 /// Game-thread time of one frame.
 struct FrameTiming {
-  double gameMs = 0;  ///< transform update + submission + commit on the game thread
-  double waitMs = 0;  ///< time blocked on the render thread before the frame could start
+  double gameMs = 0;    ///< transform update + submission + commit on the game thread
+  double commitMs = 0;  ///< of gameMs, the commit (batch hand-over or frame fence)
+  double waitMs = 0;    ///< time blocked on the render thread before the frame could start
 };
 
 /// Drives frames for one store in one submission mode (see file comment).

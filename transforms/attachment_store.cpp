@@ -67,6 +67,8 @@ uint32_t AttachmentStore::addLight(uint32_t body, uint32_t parent, const Vec3f& 
   return id;
 }
 
+void AttachmentStore::markAllDirty() { std::fill(localDirty_.begin(), localDirty_.end(), uint8_t(1)); }
+
 void AttachmentStore::setLocalOffset(uint32_t id, const Vec3f& localTranslation, const Quatf& localRotation) {
   const char* context = "AttachmentStore::setLocalOffset";
   if (id >= size()) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " does not exist");

@@ -58,6 +58,9 @@ class AttachmentStore {
                     float attenuationRadius);
   /// Changes a local offset; the attachment and its subtree are recomputed on the next update.
   void setLocalOffset(uint32_t id, const Vec3f& localTranslation, const Quatf& localRotation);
+  /// Recomputes and resends every attachment on the next update (after a frame the render side
+  /// never applied, e.g. a batch overflow, so the render scene catches up in one frame).
+  void markAllDirty();
   /// Reserves room for n attachments (setup-time allocation, keeps add* from reallocating).
   void reserve(uint32_t n);
 

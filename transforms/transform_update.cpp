@@ -1,5 +1,7 @@
 #include "transforms/transform_update.h"
 
+#include <algorithm>
+#include <chrono>
 #include <string>
 
 #include "collision/core/argument_checks.h"
@@ -19,33 +21,60 @@ TransformUpdate::TransformUpdate(AttachmentStore& store, const BodyPoseView& bod
   levelCount_ = store.levelCount();
 }
 
-void TransformUpdate::runRange(uint32_t begin, uint32_t end) const {
+template <bool Timed>
+void TransformUpdate::runBlocks(uint32_t begin, uint32_t end, UpdateRangeTimes* times) const {
+  using Clock = std::chrono::steady_clock;
   const AttachmentColumns& c = columns_;
-  for (uint32_t k = begin; k < end; ++k) {
-    const uint32_t id = c.levelOrder[k];
-    const uint32_t parent = c.parent[id];
-    const uint32_t body = c.body[id];
-    // note: a parent is one level up, finished before this level started, so reading its
-    // moved flag and pose here is race-free.
-    const bool parentMoved = parent == kInvalidIndex ? bodies_.moved[body] != 0 : c.moved[parent] != 0;
-    const bool moved = parentMoved || c.localDirty[id] != 0;
-    c.moved[id] = moved ? 1 : 0;
-    if (!moved) continue;
-    c.localDirty[id] = 0;
-    const Vec3d previousTranslation = c.worldTranslation[id];
-    const Quatf previousRotation = c.worldRotation[id];
-    if (parent == kInvalidIndex)
-      composeAttachmentPose(bodies_.position[body], bodies_.rotation[body], c.localTranslation[id],
-                            c.localRotation[id], c.worldTranslation[id], c.worldRotation[id]);
-    else
-      composeAttachmentPose(c.worldTranslation[parent], c.worldRotation[parent], c.localTranslation[id],
-                            c.localRotation[id], c.worldTranslation[id], c.worldRotation[id]);
-    if (c.kind[id] == AttachmentKind::Primitive)
-      sink_.primitive(makePrimitiveUpdate(c.renderId[id], c.localBounds[id], c.worldTranslation[id],
-                                          c.worldRotation[id], previousTranslation, previousRotation));
-    else
-      sink_.light(makeLightUpdate(c.renderId[id], c.worldTranslation[id], c.worldRotation[id]));
+  PrimitiveUpdate primitives[kRecordBlock];
+  LightUpdate lights[kRecordBlock];
+  for (uint32_t blockBegin = begin; blockBegin < end; blockBegin += kRecordBlock) {
+    const uint32_t blockEnd = std::min(end, blockBegin + kRecordBlock);
+    Clock::time_point t0;
+    if constexpr (Timed) t0 = Clock::now();
+    uint32_t nPrimitives = 0, nLights = 0;
+    for (uint32_t k = blockBegin; k < blockEnd; ++k) {
+      const uint32_t id = c.levelOrder[k];
+      const uint32_t parent = c.parent[id];
+      const uint32_t body = c.body[id];
+      // note: a parent is one level up, finished before this level started, so reading its
+      // moved flag and pose here is race-free.
+      const bool parentMoved = parent == kInvalidIndex ? bodies_.moved[body] != 0 : c.moved[parent] != 0;
+      const bool moved = parentMoved || c.localDirty[id] != 0;
+      c.moved[id] = moved ? 1 : 0;
+      if (!moved) continue;
+      c.localDirty[id] = 0;
+      const Vec3d previousTranslation = c.worldTranslation[id];
+      const Quatf previousRotation = c.worldRotation[id];
+      if (parent == kInvalidIndex)
+        composeAttachmentPose(bodies_.position[body], bodies_.rotation[body], c.localTranslation[id],
+                              c.localRotation[id], c.worldTranslation[id], c.worldRotation[id]);
+      else
+        composeAttachmentPose(c.worldTranslation[parent], c.worldRotation[parent], c.localTranslation[id],
+                              c.localRotation[id], c.worldTranslation[id], c.worldRotation[id]);
+      if (c.kind[id] == AttachmentKind::Primitive)
+        primitives[nPrimitives++] = makePrimitiveUpdate(c.renderId[id], c.localBounds[id], c.worldTranslation[id],
+                                                        c.worldRotation[id], previousTranslation, previousRotation);
+      else
+        lights[nLights++] = makeLightUpdate(c.renderId[id], c.worldTranslation[id], c.worldRotation[id]);
+    }
+    Clock::time_point t1;
+    if constexpr (Timed) t1 = Clock::now();
+    if (nPrimitives) sink_.primitives(primitives, nPrimitives);
+    if (nLights) sink_.lights(lights, nLights);
+    if constexpr (Timed) {
+      const Clock::time_point t2 = Clock::now();
+      times->updateNs += std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
+      times->submitNs += std::chrono::duration_cast<std::chrono::nanoseconds>(t2 - t1).count();
+      times->primitives += nPrimitives;
+      times->lights += nLights;
+    }
   }
+}
+
+void TransformUpdate::runRange(uint32_t begin, uint32_t end) const { runBlocks<false>(begin, end, nullptr); }
+
+void TransformUpdate::runRangeTimed(uint32_t begin, uint32_t end, UpdateRangeTimes& times) const {
+  runBlocks<true>(begin, end, &times);
 }
 
 void TransformUpdate::run(JobSystem& jobs, uint32_t grain) {

@@ -35,25 +35,34 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
     const Vec3d var = sq / n - (mean / n).cwiseProduct(mean / n);
     var.maxCoeff(&axis);
   }
+  // Ties break by id so the order is a pure function of the bounds (whichever sort made it).
+  auto less = [&](uint32_t a, uint32_t b) {
+    const double ma = bounds[a].min[axis], mb = bounds[b].min[axis];
+    return ma < mb || (ma == mb && a < b);
+  };
   if (axis != axis_ || order_.size() != n) {
+    // No order to start from (the first frame, a new axis, bodies added): sort in bulk,
+    // O(n log n), where an insertion sort from scratch is quadratic (100k bodies: seconds).
     axis_ = axis;
     order_.resize(n);
     for (uint32_t i = 0; i < n; ++i) order_[i] = i;
-  }
-  // Insertion sort from last frame's order: near-linear for coherent motion. Ties break by id
-  // so the order is a pure function of the bounds.
-  auto less = [&](uint32_t a, uint32_t b) {
-    const double ma = bounds[a].min[axis_], mb = bounds[b].min[axis_];
-    return ma < mb || (ma == mb && a < b);
-  };
-  for (uint32_t i = 1; i < n; ++i) {
-    const uint32_t v = order_[i];
-    uint32_t j = i;
-    while (j > 0 && less(v, order_[j - 1])) {
-      order_[j] = order_[j - 1];
-      --j;
+    std::sort(order_.begin(), order_.end(), less);
+  } else {
+    // Insertion sort from last frame's order: near-linear for coherent motion. When bodies
+    // jumped far (more than a few moves per body), it gives up and sorts in bulk.
+    const uint64_t budget = 8ull * n + 1024;
+    uint64_t moves = 0;
+    for (uint32_t i = 1; i < n && moves <= budget; ++i) {
+      const uint32_t v = order_[i];
+      uint32_t j = i;
+      while (j > 0 && less(v, order_[j - 1])) {
+        order_[j] = order_[j - 1];
+        --j;
+      }
+      order_[j] = v;
+      moves += i - j;
     }
-    order_[j] = v;
+    if (moves > budget) std::sort(order_.begin(), order_.end(), less);
   }
   const int a1 = (axis_ + 1) % 3, a2 = (axis_ + 2) % 3;
   sorted_.resize(n);

@@ -2,7 +2,9 @@
 /// Body-level broadphase: which bodies' world bounds overlap.
 ///
 /// Choice: sweep and prune on the axis of largest spread, with the sorted order kept from
-/// frame to frame (insertion sort is near-linear when bodies move a little per step). Bodies
+/// frame to frame (insertion sort is near-linear when bodies move a little per step); the
+/// first frame, and any frame whose insertion sort would exceed ~8 moves per body, sorts in
+/// bulk instead (O(n log n): no quadratic first frame). Bodies
 /// are few (thousands) next to the bricks inside grids, which never pay a per-frame index
 /// update here: a grid is one box in this list. Pairs of two static bodies are skipped.
 ///

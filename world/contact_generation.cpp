@@ -58,15 +58,22 @@ WorldAabb World::broadphaseBounds(uint32_t body) const {
   return boundsOf(body, reach);
 }
 
-void World::computeBounds() {
+void World::computeBounds(const Vec3f& gravityDt, int stage) {
   const uint32_t n = bodies_.size();
   bounds_.resize(n);
   isStatic_.resize(n);
   reach_.resize(n);
-  for (uint32_t i = 0; i < n; ++i) {
-    bounds_[i] = boundsOf(i, reach_[i]);
-    isStatic_[i] = bodies_.motion[i] == MotionType::Static;
-  }
+  // Per body: gravity on an awake dynamic body (semi-implicit Euler: before everything that
+  // reads the velocity), then its bounds. Each body writes only its own slots: parallel, and
+  // the same for any thread count.
+  jobs_.parallelFor(0, n, tuning::kBodyGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler_, "gravity and bounds", stage);
+    for (uint32_t i = begin; i < end; ++i) {
+      if (bodies_.motion[i] == MotionType::Dynamic && !sleep_.asleep(i)) bodies_.linearVelocity[i] += gravityDt;
+      bounds_[i] = boundsOf(i, reach_[i]);
+      isStatic_[i] = bodies_.motion[i] == MotionType::Static;
+    }
+  });
 }
 
 void World::generateContacts(float dt) {

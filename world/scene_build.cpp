@@ -17,22 +17,27 @@ namespace bw {
 
 // Bricks of a grid description: a generator's build, a save's bricks, or the listed ones, then
 // tiled when asked. Content errors name the scene, the grid and the file.
-std::vector<Brick> World::gridBricks(const GridDescription& g) const {
+std::vector<Brick> World::gridBricks(const GridDescription& g, std::vector<BuildLight>& lights) const {
   std::vector<Brick> bricks;
   Aabb bounds = Aabb::empty();
   try {
     if (!g.file.empty()) {
       BrsLoadResult save = loadBrs(g.file);
       bricks = std::move(save.bricks);
+      lights = std::move(save.lights);
       bounds = save.bounds;
     } else if (!g.generator.empty()) {
       GeneratedBuild build = generateBuild(g.generator, g.seed, g.scale);
       bricks = std::move(build.bricks);
+      lights = std::move(build.lights);
       bounds = build.bounds;
     } else {
       return g.bricks;
     }
-    if (g.tilesX > 1 || g.tilesY > 1) bricks = tileBuild(bricks, bounds, g.tilesX, g.tilesY, g.tileGap);
+    if (g.tilesX > 1 || g.tilesY > 1) {
+      bricks = tileBuild(bricks, bounds, g.tilesX, g.tilesY, g.tileGap);
+      lights = tileLights(lights, bounds, g.tilesX, g.tilesY, g.tileGap);
+    }
   } catch (const InvalidInput& e) {
     throw SceneError(scene_.source + ": grid '" + g.name + "': " + e.what());
   }
@@ -41,11 +46,13 @@ std::vector<Brick> World::gridBricks(const GridDescription& g) const {
 }
 
 void World::buildGrid(const GridDescription& g) {
-  const std::vector<Brick> bricks = gridBricks(g);
+  std::vector<BuildLight> lights;
+  const std::vector<Brick> bricks = gridBricks(g, lights);
   auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(bricks.size() + 1024)));
   for (const Brick& b : bricks) grid->placeBrick(b);
   grids_.push_back(std::move(grid));
   gridNames_.push_back(g.name);
+  gridLights_.push_back(std::move(lights));
   addGridBody(uint32_t(grids_.size() - 1), g.position, g.rotation, g.motion, g.kinematic.linearVelocity, g.kinematic.angularVelocity);
 }
 

@@ -31,6 +31,8 @@ constexpr double kMinVoxelSize = 1e-3, kMaxVoxelSize = 1e3;
 constexpr double kMinWaterDensity = 1, kMaxWaterDensity = 1e5;
 constexpr uint32_t kMaxSpawnCount = 1'000'000;
 constexpr double kMaxRayLength = 1e7;
+constexpr double kMinRenderChunk = 0.1, kMaxRenderChunk = 1e4;  ///< grid render chunk edge
+constexpr uint32_t kMaxBatchCapacity = 1u << 28;                 ///< records per frame in a batch
 }  // namespace scene_limits
 
 /// How a body moves.
@@ -90,6 +92,17 @@ struct RayLoadDescription {
   uint64_t seed = 1;
 };
 
+/// Render attachments (DESIGN.md frame steps 5-7): every body gets a render proxy, a grid one
+/// proxy per render chunk of its bricks and its lights (from the save's light components or the
+/// generator's lamps). A scene without this section builds no render thread.
+struct AttachmentsDescription {
+  bool enabled = false;            ///< the scene declared "attachments"
+  float renderChunk = 8.f;         ///< edge of a grid's render chunk (grid-local cells), world units
+  bool gridLights = true;          ///< grids carry their builds' lights
+  /// Records a frame's batch holds (batched submission); 0 = every primitive / every light.
+  uint32_t batchPrimitives = 0, batchLights = 0;
+};
+
 /// What the world does with a dynamic body that starts inside solid (depenetration.h).
 enum class StartInSolid : uint8_t { PushOut, Refuse };
 
@@ -123,6 +136,7 @@ struct SceneDescription {
   std::vector<SpawnerDescription> spawners;
   std::vector<TerrainDescription> terrains;
   RayLoadDescription rays;
+  AttachmentsDescription attachments;
 };
 
 }  // namespace bw

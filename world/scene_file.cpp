@@ -286,6 +286,21 @@ RayLoadDescription parseRays(const Field& f) {
   return r;
 }
 
+AttachmentsDescription parseAttachments(const Field& f) {
+  f.allowOnly({"render_chunk", "grid_lights", "batch_capacity"});
+  AttachmentsDescription a;
+  a.enabled = true;
+  if (f.has("render_chunk")) a.renderChunk = float(f.at("render_chunk").number(scene_limits::kMinRenderChunk, scene_limits::kMaxRenderChunk));
+  if (f.has("grid_lights")) a.gridLights = f.at("grid_lights").boolean();
+  if (f.has("batch_capacity")) {
+    const Field c = f.at("batch_capacity");
+    c.allowOnly({"primitives", "lights"});
+    if (c.has("primitives")) a.batchPrimitives = uint32_t(c.at("primitives").integer(1, scene_limits::kMaxBatchCapacity));
+    if (c.has("lights")) a.batchLights = uint32_t(c.at("lights").integer(1, scene_limits::kMaxBatchCapacity));
+  }
+  return a;
+}
+
 }  // namespace
 
 SceneDescription parseScene(const std::string& jsonText, const std::string& sourceName) {
@@ -296,7 +311,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     throw SceneError(sourceName + ": not valid JSON (" + e.what() + ")");
   }
   const Field root(doc, "scene", sourceName);
-  root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays"});
+  root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays", "attachments"});
   SceneDescription scene;
   scene.source = sourceName;
   scene.name = root.at("name").string();
@@ -323,6 +338,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     for (size_t i = 0; i < n; ++i) scene.terrains.push_back(parseTerrain(terrains.index(i), sourceName));
   }
   if (root.has("rays")) scene.rays = parseRays(root.at("rays"));
+  if (root.has("attachments")) scene.attachments = parseAttachments(root.at("attachments"));
   if (scene.grids.empty() && scene.spawners.empty() && scene.terrains.empty())
     root.failMessage("declares no grids, spawners or terrains: nothing to simulate");
   return scene;

@@ -104,6 +104,11 @@ void validateScene(const SceneDescription& scene) {
     if (t.waterFirst >= 0 && (t.waterFirst > t.waterLast || t.waterLast > 255)) c.message(f + ".water", "expected 1 <= first <= last <= 255");
   }
   c.number("rays.length", scene.rays.length, 0, kMaxRayLength);
+  if (scene.attachments.enabled) {
+    c.number("attachments.render_chunk", scene.attachments.renderChunk, kMinRenderChunk, kMaxRenderChunk);
+    c.number("attachments.batch_capacity.primitives", scene.attachments.batchPrimitives, 0, kMaxBatchCapacity);
+    c.number("attachments.batch_capacity.lights", scene.attachments.batchLights, 0, kMaxBatchCapacity);
+  }
 }
 
 }  // namespace bw

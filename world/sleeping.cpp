@@ -1,5 +1,7 @@
 #include "world/sleeping.h"
 
+#include <atomic>
+
 #include "world/world_tuning.h"
 
 namespace bw {
@@ -17,23 +19,31 @@ void SleepState::wakeTouched(const std::vector<SolverContact>& contacts) {
       if (asleep_[x]) wake(x);
 }
 
-void SleepState::update(BodyStore& bodies, const Islands& islands, float dt) {
+void SleepState::update(BodyStore& bodies, const Islands& islands, float dt, JobSystem& jobs, Profiler& profiler, int stage) {
   const uint32_t n = bodies.size();
-  for (uint32_t i = 0; i < n; ++i) {
-    if (bodies.motion[i] != MotionType::Dynamic || asleep_[i]) continue;
-    const bool still = bodies.linearVelocity[i].norm() < kSleepLinear && bodies.angularVelocity[i].norm() < kSleepAngular;
-    stillTime_[i] = still ? stillTime_[i] + dt : 0.f;
-  }
-  // An island may sleep only if every member is ready.
   blocked_.assign(n, 0);
-  for (uint32_t i = 0; i < n; ++i)
-    if (bodies.motion[i] == MotionType::Dynamic && !asleep_[i] && stillTime_[i] < kSleepTime) blocked_[islands.root(i)] = 1;
-  for (uint32_t i = 0; i < n; ++i) {
-    if (bodies.motion[i] != MotionType::Dynamic || asleep_[i] || blocked_[islands.root(i)]) continue;
-    asleep_[i] = 1;
-    bodies.linearVelocity[i] = Vec3f::Zero();
-    bodies.angularVelocity[i] = Vec3f::Zero();
-  }
+  // Still times grow or restart, and an island with a member not yet ready may not sleep. Each
+  // body writes its own still time; a blocked flag is only ever set to 1, so the threads that
+  // set the same root's flag agree and the result is the same for any thread count.
+  jobs.parallelFor(0, n, kBodyGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "sleep: still times", stage);
+    for (uint32_t i = begin; i < end; ++i) {
+      if (bodies.motion[i] != MotionType::Dynamic || asleep_[i]) continue;
+      const bool still = bodies.linearVelocity[i].norm() < kSleepLinear && bodies.angularVelocity[i].norm() < kSleepAngular;
+      stillTime_[i] = still ? stillTime_[i] + dt : 0.f;
+      if (stillTime_[i] < kSleepTime) std::atomic_ref<uint8_t>(blocked_[islands.root(i)]).store(1, std::memory_order_relaxed);
+    }
+  });
+  // Every member of an island nobody blocked falls asleep (the join above orders the flags).
+  jobs.parallelFor(0, n, kBodyGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "sleep: islands fall asleep", stage + 1);
+    for (uint32_t i = begin; i < end; ++i) {
+      if (bodies.motion[i] != MotionType::Dynamic || asleep_[i] || blocked_[islands.root(i)]) continue;
+      asleep_[i] = 1;
+      bodies.linearVelocity[i] = Vec3f::Zero();
+      bodies.angularVelocity[i] = Vec3f::Zero();
+    }
+  });
 }
 
 uint32_t SleepState::count() const {

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "jobs/job_system.h"
+#include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/islands.h"
 #include "world/solver_contact.h"
@@ -27,8 +29,9 @@ class SleepState {
   void wakeTouched(const std::vector<SolverContact>& contacts);
   /// After a substep of dt seconds: still times grow or restart, and every island (as last
   /// built) whose dynamic bodies have all been still for kSleepTime falls asleep, its
-  /// velocities zeroed.
-  void update(BodyStore& bodies, const Islands& islands, float dt);
+  /// velocities zeroed. Parallel over bodies on jobs (zones at stage and stage + 1); the same
+  /// result for any thread count.
+  void update(BodyStore& bodies, const Islands& islands, float dt, JobSystem& jobs, Profiler& profiler, int stage);
   /// Dynamic bodies asleep.
   uint32_t count() const;
 

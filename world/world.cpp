@@ -8,6 +8,7 @@
 #include "collision/core/hash.h"
 #include "world/body_mass.h"
 #include "world/scene_validation.h"
+#include "world/world_tuning.h"
 
 namespace bw {
 
@@ -18,7 +19,8 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 
 }  // namespace
 
-World::World(const SceneDescription& scene, int threads) : scene_((validateScene(scene), scene)), jobs_(threads) {
+World::World(const SceneDescription& scene, int threads, SubmissionMode submission)
+    : scene_((validateScene(scene), scene)), jobs_(threads) {
   for (const GridDescription& g : scene_.grids) buildGrid(g);
   for (const TerrainDescription& t : scene_.terrains) buildTerrain(t);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
@@ -26,6 +28,15 @@ World::World(const SceneDescription& scene, int threads) : scene_((validateScene
     if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) solidBodies_.push_back(i);
   sleep_.reset(bodies_.size());
   resolveStartsInSolid();
+  if (scene_.attachments.enabled)
+    render_ = std::make_unique<WorldRender>(buildAttachments(), submission, bodies_.size(), scene_.attachments.batchPrimitives,
+                                            scene_.attachments.batchLights);
+}
+
+const RenderScene& World::renderScene() {
+  if (!render_) throw InvalidInput("World::renderScene: scene '" + scene_.name + "' declares no attachments (no render thread)");
+  render_->finish();
+  return render_->scene();
 }
 
 const BrickGrid& World::grid(uint32_t index) const {
@@ -48,14 +59,18 @@ uint64_t World::brickCount() const {
   return n;
 }
 
-void World::integrate(float dt) {
-  for (uint32_t i = 0; i < bodies_.size(); ++i) {
-    if (bodies_.motion[i] == MotionType::Static || sleep_.asleep(i)) continue;
-    bodies_.position[i] += (bodies_.linearVelocity[i] * dt).cast<double>();
-    const Vec3f w = bodies_.angularVelocity[i];
-    const float angle = w.norm() * dt;
-    if (angle > 0) bodies_.rotation[i] = (Quatf(Eigen::AngleAxisf(angle, w / w.norm())) * bodies_.rotation[i]).normalized();
-  }
+void World::integrate(float dt, int stage) {
+  // Each body writes only its own pose: parallel, the same for any thread count.
+  jobs_.parallelFor(0, bodies_.size(), tuning::kBodyGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler_, "integrate", stage);
+    for (uint32_t i = begin; i < end; ++i) {
+      if (bodies_.motion[i] == MotionType::Static || sleep_.asleep(i)) continue;
+      bodies_.position[i] += (bodies_.linearVelocity[i] * dt).cast<double>();
+      const Vec3f w = bodies_.angularVelocity[i];
+      const float angle = w.norm() * dt;
+      if (angle > 0) bodies_.rotation[i] = (Quatf(Eigen::AngleAxisf(angle, w / w.norm())) * bodies_.rotation[i]).normalized();
+    }
+  });
 }
 
 void World::substep(float dt, int index) {
@@ -63,14 +78,10 @@ void World::substep(float dt, int index) {
   // Serial stages record one zone; parallel stages one zone per chunk (the jobs).
   const int stage = index * kStagesPerSubstep;
   stage_ = stage;
-  // Gravity on dynamic bodies first (semi-implicit Euler).
-  const Vec3f g = scene_.settings.gravity.cast<float>();
-  for (uint32_t i = 0; i < bodies_.size(); ++i)
-    if (bodies_.motion[i] == MotionType::Dynamic && !sleep_.asleep(i)) bodies_.linearVelocity[i] += g * dt;
   auto t = Clock::now();
+  computeBounds(scene_.settings.gravity.cast<float>() * dt, stage + 6);
   {
     ProfileZone z(profiler_, "broadphase", stage + 0);
-    computeBounds();
     findPairs();
   }
   stats_.broadphaseMs += msSince(t);
@@ -100,10 +111,7 @@ void World::substep(float dt, int index) {
   }
   stats_.solverMs += msSince(t);
   t = Clock::now();
-  {
-    ProfileZone z(profiler_, "integrate", stage + 4);
-    integrate(dt);
-  }
+  integrate(dt, stage + 4);
   stats_.integrateMs += msSince(t);
   t = Clock::now();
   {
@@ -114,7 +122,7 @@ void World::substep(float dt, int index) {
     solver_.storeBodies(bodies_);
   }
   stats_.solverMs += msSince(t);
-  if (scene_.settings.sleeping) sleep_.update(bodies_, islands_, dt);
+  if (scene_.settings.sleeping) sleep_.update(bodies_, islands_, dt, jobs_, profiler_, stage + 7);
   stats_.pairs += uint32_t(pairs_.size());
   stats_.contacts += uint32_t(solver_.contacts().size());
   for (uint32_t k = 0; k < pairs_.size(); ++k) {
@@ -187,9 +195,14 @@ void World::step() {
       stats_.raysMs = msSince(rays);
     }
   }
+  ++frame_;
+  if (render_) {
+    // Frame steps 5-7 (world_render.h); the stage ids follow the ray load's.
+    ProfileZone z(profiler_, "render (stage)");
+    stats_.render = render_->run(bodies_, sleep_, jobs_, profiler_, renderStage());
+  }
   profiler_.endFrame();
   stats_.totalMs = msSince(t);
-  ++frame_;
 }
 
 void World::setPoses(const std::vector<Vec3d>& positions, const std::vector<Quatf>& rotations) {
@@ -206,6 +219,7 @@ void World::setPoses(const std::vector<Vec3d>& positions, const std::vector<Quat
     bodies_.rotation[i] = rotations[i].normalized();
   }
   pairCache_.forget([](const BodyPair&) { return true; });
+  if (render_) render_->checkAllBodies();
 }
 
 uint64_t World::stateHash() const {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "collision/bricks/brick_grid.h"
+#include "collision/content/build_light.h"
 #include "collision/terrain/terrain.h"
 #include "jobs/job_system.h"
 #include "jobs/profiler.h"
@@ -35,6 +36,7 @@
 #include "world/ray_load.h"
 #include "world/scene_description.h"
 #include "world/sleeping.h"
+#include "world/world_render.h"
 
 namespace bw {
 
@@ -53,14 +55,19 @@ struct StepStats {
   uint32_t floating = 0;         ///< awake bodies touching water (last substep)
   uint32_t largestIsland = 0;    ///< contacts in the largest island (last substep)
   uint32_t splitIslands = 0;     ///< islands solved colour by colour on every thread
+  RenderStageStats render;       ///< frame steps 5-7 (zero without attachments)
 };
 
 class World {
  public:
   /// Builds everything the scene declares. Throws InvalidInput / SceneError on bad content.
-  World(const SceneDescription& scene, int threads);
+  /// A scene with attachments gets a render thread fed in `submission` mode.
+  World(const SceneDescription& scene, int threads, SubmissionMode submission = SubmissionMode::Batched);
 
-  /// One frame (settings.timestep seconds), in settings.substeps substeps.
+  /// One frame (settings.timestep seconds), in settings.substeps substeps, then (with
+  /// attachments) frame steps 5-7: the moved bodies' attachments updated and submitted, the
+  /// frame committed to the render thread, which applies it while the next frame simulates.
+  /// A batch overflow throws CapacityExceeded after the frame's physics is done (world_render.h).
   void step();
   /// Frames stepped so far.
   uint32_t frame() const { return frame_; }
@@ -121,6 +128,13 @@ class World {
   /// The push-out of a body on its way out of solid (its saved dynamic mass and spawn
   /// velocity), or nullptr when it is not being pushed out.
   const Depenetration* depenetration(uint32_t body) const;
+  /// First profiling stage id of the render frame (world_render.h: renderStageKind).
+  int renderStage() const { return scene_.settings.substeps * kStagesPerSubstep + 1; }
+  /// The render side, or nullptr when the scene declares no attachments.
+  const WorldRender* render() const { return render_.get(); }
+  /// The render scene after every stepped frame was applied (waits for the render thread).
+  /// InvalidInput when the scene declares no attachments.
+  const RenderScene& renderScene();
   /// Moves every body to the given centre and rotation (body frame, as bodies().position and
   /// rotation hold them), velocities kept: to follow another engine's run with this world's
   /// queries (the Bullet baseline's containment) or to restore saved poses. Cached contacts are
@@ -130,10 +144,12 @@ class World {
 
  private:
   // Scene building (scene_build.cpp).
-  std::vector<Brick> gridBricks(const GridDescription& g) const;
+  std::vector<Brick> gridBricks(const GridDescription& g, std::vector<BuildLight>& lights) const;
   void buildGrid(const GridDescription& g);
   void buildTerrain(const TerrainDescription& t);
   void spawn(const SpawnerDescription& s);
+  // Render attachments of every body (render_attachments.cpp).
+  AttachmentStore buildAttachments() const;
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
   // Bodies that start inside solid (depenetration.cpp).
@@ -143,7 +159,8 @@ class World {
   void finishDepenetration();
   std::string bodySource(uint32_t body) const;
   // Bounds and contacts (contact_generation.cpp, terrain_pairs.cpp).
-  void computeBounds();
+  /// Gravity (velocity += gravityDt) on awake dynamic bodies, then every body's bounds; parallel.
+  void computeBounds(const Vec3f& gravityDt, int stage);
   WorldAabb boundsOf(uint32_t body, float& reach) const;
   // The broadphase over proxies (broadphase_proxies.cpp): pairs_ from bounds_.
   void findPairs();
@@ -157,18 +174,20 @@ class World {
   }
   // The step (world.cpp).
   void substep(float dt, int index);
-  void integrate(float dt);
+  void integrate(float dt, int stage);
   void applyGridEdits();
   /// A dynamic grid body's mass, centre of mass and inertia after its grid was edited.
   void refreshGridBodyMass(uint32_t body);
-  // Profiling stages per substep: broadphase, contacts, prepare, solve, integrate, relax.
-  static constexpr int kStagesPerSubstep = 6;
+  // Profiling stages per substep: broadphase, contacts, prepare, solve, integrate, relax,
+  // gravity + bounds (stage 6, which runs first), and sleeping's two passes (7, 8).
+  static constexpr int kStagesPerSubstep = 9;
 
   SceneDescription scene_;
   JobSystem jobs_;
   Profiler profiler_;
   std::vector<std::unique_ptr<BrickGrid>> grids_;
   std::vector<std::string> gridNames_;
+  std::vector<std::vector<BuildLight>> gridLights_;  // per grid: its build's lights (grid frame)
   // Terrains are static bodies too. Their chunk cache is filled by queries (not thread-safe),
   // so pairs with a terrain are collided on one thread after the parallel pairs.
   std::vector<std::unique_ptr<Terrain>> terrains_;
@@ -211,6 +230,8 @@ class World {
   StepStats stats_;
   uint32_t frame_ = 0;
   int stage_ = 0;  // first profiling stage id of the running substep
+  // Last member: the render thread stops before anything it was fed from goes away.
+  std::unique_ptr<WorldRender> render_;
 };
 
 }  // namespace bw

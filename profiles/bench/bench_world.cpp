@@ -18,7 +18,19 @@
 //   btCompoundNaive    - each grid one btCompoundShape of one box per brick, no CCD (the
 //                        article's "compounds" point; not run on city_rain: ~1 s a frame)
 // Counters: median and p95 frame time (ms), contacts per frame; the summary prints the
-// ratios, expert first.
+// ratios, expert first. The scenes' render attachments are left out here (Bullet has no render
+// side): these rows compare physics with physics.
+//
+// WorldRender/<mode>/<scene>: the world's frame steps 5-7 (transform update of the moved
+// bodies' attachments, submission, commit to the render thread) in each submission mode, from
+// the same initial state, on one thread:
+//   Batched              - one atomic-append batch (a fetch_add per block of records), one commit
+//   PerObjectMutex       - one command per record into a mutex-guarded queue (like for like:
+//                          no light-radius refresh)
+//   PerObjectConcurrent  - the same into oneTBB's lock-free concurrent_queue
+// Counters: submission + commit ms per frame (measured, and predicted at 16 threads from the
+// run's work/span with the mutex pushes serial), transform update ms, records per frame; the
+// summary prints per-object / batched.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -153,7 +165,8 @@ double quantile(std::vector<double> v, double q) {
 }
 
 void WorldFrame(benchmark::State& state, Engine engine, const char* scene) {
-  const SceneDescription description = loadScene(std::string(BW_SOURCE_DIR) + "/profiles/scenes/" + scene + ".json");
+  SceneDescription description = loadScene(std::string(BW_SOURCE_DIR) + "/profiles/scenes/" + scene + ".json");
+  description.attachments = AttachmentsDescription{};  // physics against physics
   std::vector<double> frameMs;
   uint64_t contacts = 0;
   for (auto _ : state) {
@@ -174,6 +187,70 @@ void WorldFrame(benchmark::State& state, Engine engine, const char* scene) {
   state.counters["frame_ms_median"] = median;
   state.counters["frame_ms_p95"] = quantile(frameMs, 0.95);
   state.counters["contacts_per_frame"] = double(contacts) / double(frameMs.size());
+}
+
+// ---------------------------------------------------------------- the render frame per mode
+
+const char* const kRenderScenes[] = {"crates_on_grid", "carrier_fleet"};
+const SubmissionMode kRenderModes[] = {SubmissionMode::Batched, SubmissionMode::PerObjectMutexNoRadius,
+                                       SubmissionMode::PerObjectConcurrentNoRadius};
+const char* renderModeName(SubmissionMode m) {
+  return m == SubmissionMode::Batched ? "Batched" : m == SubmissionMode::PerObjectMutexNoRadius ? "PerObjectMutex" : "PerObjectConcurrent";
+}
+
+std::map<std::string, std::pair<double, double>>& renderFigures() {  // "<mode>/<scene>" -> (measured, predicted at 16) ms
+  static std::map<std::string, std::pair<double, double>> m;
+  return m;
+}
+
+void WorldRenderFrame(benchmark::State& state, SubmissionMode mode, const char* scene) {
+  const SceneDescription description = loadScene(std::string(BW_SOURCE_DIR) + "/profiles/scenes/" + scene + ".json");
+  constexpr uint32_t kFrames = 60;
+  double submitCommit = 0, update = 0, predicted16 = 0;
+  uint64_t records = 0;
+  for (auto _ : state) {
+    World world(description, 1, mode);
+    for (uint32_t f = 0; f < kFrames; ++f) {
+      world.step();
+      const RenderStageStats& r = world.lastStats().render;
+      submitCommit += r.submissionMs + r.commitMs;
+      update += r.updateMs;
+      records += r.primitives + r.lights;
+    }
+    world.renderScene();
+    // Submission + commit at 16 threads: per stage max(work / 16, span); the mutex queue's
+    // pushes are serial zones, all in the span.
+    for (const WorkSpan& ws : world.profiler().workSpans(kFrames))
+      for (size_t k = 0; k < ws.stageIds.size(); ++k) {
+        const int offset = ws.stageIds[k] - world.renderStage();
+        if (offset < 0 || offset > kRenderCommitStage) continue;
+        const RenderStageKind kind = renderStageKind(offset);
+        if (kind == RenderStageKind::Submission || kind == RenderStageKind::Commit)
+          predicted16 += std::max(ws.stageWorkMs[k] / 16, ws.stageSpanMs[k]);
+      }
+  }
+  const double frames = double(kFrames) * double(state.iterations());
+  renderFigures()[std::string(renderModeName(mode)) + "/" + scene] = {submitCommit / frames, predicted16 / frames};
+  state.counters["submit_commit_ms"] = submitCommit / frames;
+  state.counters["submit_commit_ms_16thr"] = predicted16 / frames;
+  state.counters["update_ms"] = update / frames;
+  state.counters["records_per_frame"] = double(records) / frames;
+}
+
+void printRenderRatios() {
+  const auto& m = renderFigures();
+  for (const char* scene : kRenderScenes) {
+    const std::string b = std::string("Batched/") + scene;
+    if (!m.count(b)) continue;
+    std::printf("%s: batched submission + commit %.3f ms a frame (%.3f predicted at 16 threads)", scene, m.at(b).first, m.at(b).second);
+    for (const char* other : {"PerObjectMutex", "PerObjectConcurrent"}) {
+      const std::string k = std::string(other) + "/" + scene;
+      if (m.count(k))
+        std::printf("; %s %.1fx (%.1fx at 16)", other, m.at(k).first / std::max(m.at(b).first, 1e-9),
+                    m.at(k).second / std::max(m.at(b).second, 1e-9));
+    }
+    std::printf("\n");
+  }
 }
 
 void printWorldRatios() {
@@ -205,10 +282,17 @@ int main(int argc, char** argv) {
           ->Iterations(1)
           ->Unit(benchmark::kMillisecond);
     }
+  for (const char* scene : kRenderScenes)
+    for (SubmissionMode mode : kRenderModes)
+      benchmark::RegisterBenchmark((std::string("WorldRender/") + renderModeName(mode) + "/" + scene).c_str(), WorldRenderFrame, mode,
+                                   scene)
+          ->Iterations(1)
+          ->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   printWorldRatios();
+  printRenderRatios();
   return 0;
 }

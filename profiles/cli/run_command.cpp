@@ -8,6 +8,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <thread>
 
 #include "cli/command_registry.h"
 #include "cli/scene_run.h"
@@ -169,7 +170,9 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
       ->check(CLI::Range(1u, 1'000'000'000u));
   cmd.add_option("--seed", *seed, "octobvh/pool: random seed");
   cmd.add_option("--frames", scene->frames, "scene: frames to run (default: the scene's)")->check(CLI::Range(1u, 10'000'000u));
-  cmd.add_option("--threads", scene->threads, "scene: worker threads")->check(CLI::Range(1, 1024));
+  scene->threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  cmd.add_option("--threads", scene->threads, "scene: worker threads (default: the machine's hardware threads; the state hash is the same for any count)")
+      ->check(CLI::Range(1, 1024));
   cmd.add_option("--csv", scene->csvPath, "scene: write per-frame stage times to this CSV");
   cmd.add_option("--trace", scene->tracePath, "scene: write a Chrome trace (open in Perfetto)");
   cmd.add_option("--engine", scene->engine,
@@ -178,6 +181,11 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
       ->check(CLI::IsMember({"brickworld", "bullet", "bullet-naive", "both", "all"}));
   cmd.add_option("--bullet-chunk", scene->bulletChunk, "scene: chunk edge of the expert Bullet setup's static compounds, m (default 16, the fastest measured)")
       ->check(CLI::Range(0.1f, 10000.f));
+  cmd.add_option("--submission", scene->submission,
+                 "scene with attachments: how transform updates reach the render thread: batched (default: one atomic-append "
+                 "batch committed once per frame), mutex or concurrent (one command per update into a mutex / lock-free queue), "
+                 "all (the three from the same initial state: ratios, render-scene hashes required equal)")
+      ->check(CLI::IsMember({"batched", "mutex", "concurrent", "all"}));
   cmd.add_option("--sleeping", scene->sleeping, "scene: on/off overrides the scene's sleeping setting")
       ->check(CLI::IsMember({"on", "off"}));
   cmd.add_option("--drift-after", scene->driftAfter,

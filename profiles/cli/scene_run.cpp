@@ -12,6 +12,8 @@
 #include <sys/resource.h>
 #include <vector>
 
+#include "cli/render_figures.h"
+#include "cli/series.h"
 #include "world/bullet_baseline.h"
 #include "world/scene_file.h"
 #include "world/world.h"
@@ -19,17 +21,6 @@
 namespace bw::cli {
 
 namespace {
-
-struct Series {
-  std::vector<double> v;
-  double quantile(double q) const {
-    if (v.empty()) return 0;
-    std::vector<double> s = v;
-    std::sort(s.begin(), s.end());
-    return s[std::min(s.size() - 1, size_t(q * double(s.size() - 1) + 0.5))];
-  }
-  double max() const { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
-};
 
 double peakResidentMiB() {
   rusage u{};
@@ -72,7 +63,9 @@ nlohmann::json insideSolidList(const ContainmentReport& inside, const std::vecto
 double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, float chunkSize, uint32_t frames, bool json,
                  nlohmann::json& out) {
   using Clock = std::chrono::steady_clock;
-  World judge(scene, threads);
+  SceneDescription judged = scene;
+  judged.attachments = AttachmentsDescription{};  // the judge only answers containment queries
+  World judge(judged, threads);
   BulletBaseline bullet(judge, setup, chunkSize);
   ContainmentTracker containment(judge);
   std::vector<Vec3d> positions;
@@ -146,6 +139,13 @@ std::vector<BulletSetup> bulletSetups(const std::string& engine) {
   return {};
 }
 
+SubmissionMode submissionModeFromName(const std::string& name) {
+  if (name == "batched" || name == "all") return SubmissionMode::Batched;
+  if (name == "mutex") return SubmissionMode::PerObjectMutexNoRadius;
+  if (name == "concurrent") return SubmissionMode::PerObjectConcurrentNoRadius;
+  throw std::invalid_argument("--submission must be batched, mutex, concurrent or all (got '" + name + "')");
+}
+
 int runScene(const SceneRunOptions& o) {
   using Clock = std::chrono::steady_clock;
   const std::string path = resolveScenePath(o.scene);
@@ -161,8 +161,14 @@ int runScene(const SceneRunOptions& o) {
     if (o.json) std::cout << nlohmann::json{{"scene", scene.name}, {"engine", o.engine}, {"bullet", b}}.dump(2) << "\n";
     return 0;
   }
+  const std::string submissionName = o.submission.empty() ? "batched" : o.submission;
+  const SubmissionMode submission = submissionModeFromName(submissionName);
+  if (!o.submission.empty() && !scene.attachments.enabled)
+    throw SceneError(path + ": --submission " + o.submission + ": the scene declares no attachments (no render thread to submit to)");
+  if (!o.tracePath.empty() && !std::ofstream(o.tracePath))
+    throw std::runtime_error("--trace: cannot write " + o.tracePath);  // checked before the run, not after it
   const auto tBuild = Clock::now();
-  World world(scene, o.threads);
+  World world(scene, o.threads, submission);
   const double buildMs = std::chrono::duration<double, std::milli>(Clock::now() - tBuild).count();
   const uint32_t frames = o.frames ? o.frames : scene.settings.frames;
 
@@ -174,12 +180,13 @@ int runScene(const SceneRunOptions& o) {
     csv.open(o.csvPath);
     if (!csv) throw std::runtime_error("cannot write " + o.csvPath);
     csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,rays_ms,pairs,contacts,box_tests,ray_hits,"
-           "bodies_inside_solid\n";
+           "bodies_inside_solid,transform_update_ms,submission_ms,commit_ms,render_wait_ms,render_busy_ms,moved_bodies,records\n";
   }
   double work = 0, span = 0;
   float deepest = 0, endDeepest = 0;  // deepest contact over the run and in the last frame
   std::vector<Vec3d> settled;  // positions at --drift-after
   ContainmentTracker containment(world);  // updated after each step, outside its timing
+  RenderFigures render;
   const auto tRun = Clock::now();
   for (uint32_t f = 0; f < frames; ++f) {
     if (o.driftAfter && f == o.driftAfter) settled = world.bodies().position;
@@ -194,6 +201,7 @@ int runScene(const SceneRunOptions& o) {
     solver.v.push_back(s.solverMs);
     integrate.v.push_back(s.integrateMs);
     rays.v.push_back(s.raysMs);
+    if (world.render()) render.add(s.render);
     rayCount += s.rays;
     rayHits += s.rayHits;
     rayBoxTests += s.rayBoxTests;
@@ -207,11 +215,14 @@ int runScene(const SceneRunOptions& o) {
     reused += s.pairsReused;
     if (csv) csv << f << "," << s.totalMs << "," << s.broadphaseMs << "," << s.contactsMs << "," << s.solverMs << ","
                  << s.integrateMs << "," << s.raysMs << "," << s.pairs << "," << s.contacts << "," << s.boxTests << "," << s.rayHits
-                 << "," << containment.report().count() << "\n";
+                 << "," << containment.report().count() << "," << s.render.updateMs << "," << s.render.submissionMs << ","
+                 << s.render.commitMs << "," << s.render.waitMs << "," << s.render.renderBusyMs << "," << s.render.movedBodies << ","
+                 << s.render.primitives + s.render.lights << "\n";
     if (o.progress && !o.json && frames >= 100 && (f + 1) % (frames / 10) == 0)
       std::fprintf(stderr, "  frame %u/%u  %.2f ms\n", f + 1, frames, s.totalMs);
   }
   const double runS = std::chrono::duration<double>(Clock::now() - tRun).count();
+  if (world.render()) render.finish(world);
   // Work and span over the whole run (stages are sequential, each stage's work in one zone here).
   for (const WorkSpan& ws : world.profiler().workSpans(frames)) {
     work += ws.workMs;
@@ -277,6 +288,12 @@ int runScene(const SceneRunOptions& o) {
       j["ray_hit_share"] = double(rayHits) / double(rayCount);
       j["ray_box_tests_per_ray"] = double(rayBoxTests) / double(rayCount);
     }
+    bool modesAgree = true;
+    if (world.render()) {
+      j["render"] = render.json(world);
+      if (submissionName == "all")
+        modesAgree = compareSubmissionModes(scene, o.threads, frames, world, render, true, j["submission_modes"]);
+    }
     for (BulletSetup setup : setups) {
       nlohmann::json b;
       const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, frames, true, b);
@@ -285,7 +302,7 @@ int runScene(const SceneRunOptions& o) {
       j[key + "_over_brickworld_median"] = bulletMedian / std::max(total.quantile(0.5), 1e-9);
     }
     std::cout << j.dump(2) << "\n";
-    return 0;
+    return modesAgree ? 0 : 3;
   }
   std::printf("scene %s (%s): %u bodies, %llu bricks, built in %.0f ms; %u frames on %d thread(s) in %.2f s\n", scene.name.c_str(),
               path.c_str(), world.bodies().size(), (unsigned long long)world.brickCount(), buildMs, frames, o.threads, runS);
@@ -315,17 +332,23 @@ int runScene(const SceneRunOptions& o) {
   }
   if (!settled.empty())
     std::printf("  drift: largest displacement of a dynamic body from frame %u to the end %.3f mm\n", o.driftAfter, drift * 1e3);
+  if (world.render()) render.print(world);
   std::printf("  peak memory %.0f MiB; state hash %016llx\n", peakResidentMiB(), (unsigned long long)world.stateHash());
   std::printf("  work %.1f ms, span %.1f ms over the run\n", work, span);
   if (!o.csvPath.empty()) std::printf("  per-frame CSV: %s\n", o.csvPath.c_str());
   if (!o.tracePath.empty()) std::printf("  Chrome trace: %s (open in Perfetto)\n", o.tracePath.c_str());
+  bool modesAgree = true;
+  if (world.render() && submissionName == "all") {
+    nlohmann::json unused;
+    modesAgree = compareSubmissionModes(scene, o.threads, frames, world, render, false, unused);
+  }
   for (BulletSetup setup : setups) {
     nlohmann::json b;
     const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, frames, false, b);
     std::printf("%s / brickworld median frame time: %.1fx\n", setup == BulletSetup::Expert ? "bullet" : "bullet-naive",
                 bulletMedian / std::max(total.quantile(0.5), 1e-9));
   }
-  return 0;
+  return modesAgree ? 0 : 3;
 }
 
 }  // namespace bw::cli

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <string>
 
+#include "render_batch/submission_mode.h"
 #include "world/bullet_baseline.h"
 
 namespace bw::cli {
@@ -21,7 +22,13 @@ struct SceneRunOptions {
   std::string engine = "brickworld";
   float bulletChunk = BulletBaseline::kDefaultChunkSize;  ///< edge of the expert Bullet setup's chunk compounds (m)
   std::string sleeping;     ///< "on"/"off" overrides the scene's setting; empty keeps it
+  /// Scenes with attachments: batched, mutex or concurrent (per-object queues, one command per
+  /// record, like for like with the batch), or all (the three from the same initial state).
+  std::string submission;  ///< empty: batched (and no complaint about a scene without attachments)
 };
+
+/// The submission mode a --submission name stands for (batched, mutex, concurrent).
+SubmissionMode submissionModeFromName(const std::string& name);
 
 /// Runs the scene and prints the report; returns the process exit code.
 int runScene(const SceneRunOptions& options);

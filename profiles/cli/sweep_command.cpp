@@ -8,8 +8,10 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "cli/command_registry.h"
+#include "cli/render_figures.h"
 #include "cli/scene_run.h"
 #include "world/scene_file.h"
 #include "world/world.h"
@@ -23,17 +25,21 @@ struct SweepRow {
   uint64_t hash;
   double workMs, spanMs;
   WorkSpan perFrame;  // summed stage figures over the run
+  RenderFigures render;  // scenes with attachments
+  bool hasRender = false;
 };
 
-SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames) {
-  World world(scene, threads);
+SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames, SubmissionMode mode) {
+  World world(scene, threads, mode);
   std::vector<double> t;
+  RenderFigures render;
   const auto start = std::chrono::steady_clock::now();
   for (uint32_t f = 0; f < frames; ++f) {
     world.step();
     t.push_back(world.lastStats().totalMs);
+    if (world.render()) render.add(world.lastStats().render);
   }
-  SweepRow r{threads, 0, 0, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), world.stateHash(), 0, 0, {}};
+  SweepRow r{threads, 0, 0, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), world.stateHash(), 0, 0, {}, {}, false};
   std::sort(t.begin(), t.end());
   r.medianMs = t[t.size() / 2];
   r.p95Ms = t[std::min(t.size() - 1, size_t(double(t.size()) * 0.95))];
@@ -52,33 +58,54 @@ SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames) {
   }
   r.perFrame.workMs = r.workMs;
   r.perFrame.spanMs = r.spanMs;
+  if (world.render()) {
+    render.finish(world);
+    r.render = std::move(render);
+    r.hasRender = true;
+  }
   return r;
 }
 
 CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured scaling next to the work/span bound", [](CLI::App& cmd) {
   auto scene = std::make_shared<std::string>("crates_on_grid");
-  auto threads = std::make_shared<std::vector<int>>(std::vector<int>{1, 2});
+  // Default: 1 and the machine's hardware threads.
+  auto threads = std::make_shared<std::vector<int>>(std::vector<int>{1, int(std::max(2u, std::thread::hardware_concurrency()))});
   auto frames = std::make_shared<uint32_t>(0);
   auto csv = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
   auto sleeping = std::make_shared<std::string>();
+  auto submission = std::make_shared<std::string>();
   cmd.add_option("scene", *scene, "scene file or shipped scene name");
   cmd.add_option("--sleeping", *sleeping, "on/off overrides the scene's sleeping setting")->check(CLI::IsMember({"on", "off"}));
-  cmd.add_option("--threads", *threads, "thread counts, e.g. 1,2,4")->delimiter(',')->check(CLI::Range(1, 1024));
+  cmd.add_option("--threads", *threads, "thread counts, e.g. 1,2,4 (default: 1 and the machine's hardware threads; 1 is always run)")->delimiter(',')->check(CLI::Range(1, 1024));
   cmd.add_option("--frames", *frames, "frames per run (default: the scene's)")->check(CLI::Range(1u, 10'000'000u));
   cmd.add_option("--csv", *csv, "write one row per thread count");
+  cmd.add_option("--submission", *submission,
+                 "scene with attachments: batched (default), mutex, concurrent, or all (each mode at each thread count)")
+      ->check(CLI::IsMember({"batched", "mutex", "concurrent", "all"}));
   cmd.add_flag("--json", *json, "print one JSON object");
   return [=] {
-    SceneDescription desc = loadScene(resolveScenePath(*scene));
+    const std::string path = resolveScenePath(*scene);
+    SceneDescription desc = loadScene(path);
     if (!sleeping->empty()) desc.settings.sleeping = *sleeping == "on";
+    if (!submission->empty() && !desc.attachments.enabled)
+      throw SceneError(path + ": --submission " + *submission + ": the scene declares no attachments (no render thread to submit to)");
     const uint32_t n = *frames ? *frames : desc.settings.frames;
     std::vector<int> counts = *threads;
     if (std::find(counts.begin(), counts.end(), 1) == counts.end()) counts.insert(counts.begin(), 1);
+    std::vector<SubmissionMode> modes{submissionModeFromName(submission->empty() ? "batched" : *submission)};
+    if (*submission == "all") modes = {SubmissionMode::Batched, SubmissionMode::PerObjectMutexNoRadius, SubmissionMode::PerObjectConcurrentNoRadius};
+    // Every mode but the first: only its render figures are reported (the physics is the same run).
+    std::vector<std::vector<SweepRow>> otherModes;
+    for (size_t m = 1; m < modes.size(); ++m) {
+      otherModes.emplace_back();
+      for (int t : counts) otherModes.back().push_back(runAt(desc, t, n, modes[m]));
+    }
     std::vector<SweepRow> rows;
-    for (int t : counts) rows.push_back(runAt(desc, t, n));
+    for (int t : counts) rows.push_back(runAt(desc, t, n, modes[0]));
     const SweepRow& one = rows.front();
     bool sameHash = true;
-    for (const SweepRow& r : rows) sameHash = sameHash && r.hash == one.hash;
+    for (const SweepRow& r : rows) sameHash = sameHash && r.hash == one.hash && (!r.hasRender || r.render.sceneHash == one.render.sceneHash);
     if (!csv->empty()) {
       std::ofstream out(*csv);
       if (!out) throw std::runtime_error("cannot write " + *csv);
@@ -95,6 +122,25 @@ CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured
       for (int p : {2, 4, 8, 16}) j["bound_speedup"][std::to_string(p)] = one.perFrame.speedupBound(p);
       j["work_ms"] = one.workMs;
       j["span_ms"] = one.spanMs;
+      if (one.hasRender) {
+        auto modeJson = [&](const std::vector<SweepRow>& rs) {
+          nlohmann::json m{{"mode", submissionModeName(rs.front().render.mode)}};
+          for (const SweepRow& r : rs)
+            m["measured_submission_commit_ms"][std::to_string(r.threads)] = (r.render.submission.sum() + r.render.commit.sum()) / n;
+          for (int p : {1, 2, 4, 8, 16}) {
+            m["predicted_submission_commit_ms"][std::to_string(p)] = rs.front().render.predictedMs(p);
+            m["predicted_render_ms"][std::to_string(p)] = rs.front().render.predictedMs(p, true);
+          }
+          m["render_scene_hash"] = rs.front().render.sceneHash;
+          return m;
+        };
+        j["submission"].push_back(modeJson(rows));
+        for (const auto& rs : otherModes) {
+          j["submission"].push_back(modeJson(rs));
+          for (const SweepRow& r : rs) sameHash = sameHash && r.render.sceneHash == one.render.sceneHash && r.hash == one.hash;
+        }
+        j["state_hash_identical"] = sameHash;
+      }
       std::cout << j.dump(2) << "\n";
       return sameHash ? 0 : 3;
     }
@@ -106,7 +152,30 @@ CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured
     std::printf("  from the 1-thread run: work %.1f ms, span %.1f ms; speedup bound at 2/4/8/16 threads: %.2fx %.2fx %.2fx %.2fx\n",
                 one.workMs, one.spanMs, one.perFrame.speedupBound(2), one.perFrame.speedupBound(4), one.perFrame.speedupBound(8),
                 one.perFrame.speedupBound(16));
-    std::printf("  state hash %s across thread counts\n", sameHash ? "identical" : "DIFFERS");
+    if (one.hasRender) {
+      std::printf("  render frame (transform update + submission + commit); submission + commit per frame, measured and\n"
+                  "  predicted from each mode's 1-thread work/span (the mutex queue's pushes are serial: all in the span):\n");
+      std::printf("  %-28s %10s %10s | predicted %7s %7s %7s %7s %7s  %s\n", "mode", "1 thread", "2 threads", "1", "2", "4", "8", "16",
+                  "render scene hash");
+      auto modeRow = [&](const std::vector<SweepRow>& rs) {
+        auto measured = [&](int t) {
+          for (const SweepRow& r : rs)
+            if (r.threads == t) return (r.render.submission.sum() + r.render.commit.sum()) / n;
+          return 0.0;
+        };
+        const RenderFigures& f = rs.front().render;
+        std::printf("  %-28s %7.3f ms %7.3f ms | %17.3f %7.3f %7.3f %7.3f %7.3f  %016llx\n", submissionModeName(f.mode), measured(1),
+                    measured(2), f.predictedMs(1), f.predictedMs(2), f.predictedMs(4), f.predictedMs(8), f.predictedMs(16),
+                    (unsigned long long)f.sceneHash);
+      };
+      modeRow(rows);
+      for (const auto& rs : otherModes) {
+        modeRow(rs);
+        for (const SweepRow& r : rs) sameHash = sameHash && r.render.sceneHash == one.render.sceneHash && r.hash == one.hash;
+      }
+    }
+    std::printf("  state hash %s across thread counts%s\n", sameHash ? "identical" : "DIFFERS",
+                one.hasRender ? " (and render scene hashes across modes and thread counts)" : "");
     if (!csv->empty()) std::printf("  CSV: %s\n", csv->c_str());
     return sameHash ? 0 : 3;
   };

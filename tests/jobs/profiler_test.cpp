@@ -33,6 +33,44 @@ TEST(Profiler, WorkSpanAndSpeedupBoundsFromStageStructure) {
   EXPECT_EQ(p.workSpan(4).workMs, 0.0) << "other frames are separate";
 }
 
+TEST(Profiler, SerialZonesCountWholeInTheSpan) {
+  // Eight 1 ms pushes under one lock from eight jobs: however many threads, they take 8 ms.
+  Profiler p;
+  const int64_t ms = 1'000'000;
+  for (int i = 0; i < 8; ++i) p.record("push", i * ms, (i + 1) * ms, 0, /*serial*/ true);
+  for (int i = 0; i < 8; ++i) p.record("update", i * ms, (i + 1) * ms, 1);
+  const WorkSpan ws = p.workSpan(0);
+  EXPECT_DOUBLE_EQ(ws.workMs, 16.0);
+  EXPECT_DOUBLE_EQ(ws.stageSpanMs[0], 8.0);
+  EXPECT_DOUBLE_EQ(ws.stageSpanMs[1], 1.0);
+  EXPECT_DOUBLE_EQ(ws.boundMs(8), 8.0 + 1.0);
+  ASSERT_EQ(ws.stageIds.size(), 2u);
+  EXPECT_EQ(ws.stageIds[1], 1);
+}
+
+TEST(Profiler, OneFramesWorkSpanEqualsTheWholeRunPassInAnyFrameOrder) {
+  // Frames recorded in ascending order (a world's, found by binary search) and a profiler that
+  // went back to an earlier frame (scanned whole): workSpan(f) must equal workSpans()[f].
+  for (bool ascending : {true, false}) {
+    Profiler p;
+    const uint32_t frames = 50;
+    for (uint32_t k = 0; k < frames; ++k) {
+      const uint32_t f = ascending ? k : (k * 7) % frames;
+      p.beginFrame(f);
+      for (uint32_t z = 0; z <= f % 5; ++z) p.record("job", int64_t(k) * 100 + z, int64_t(k) * 100 + z + 1 + f, int32_t(z % 3), z == 2);
+      p.record("outside", 0, 5, -1);
+    }
+    const std::vector<WorkSpan> all = p.workSpans(frames);
+    for (uint32_t f = 0; f < frames; ++f) {
+      const WorkSpan one = p.workSpan(f);
+      EXPECT_DOUBLE_EQ(one.workMs, all[f].workMs) << f;
+      EXPECT_DOUBLE_EQ(one.spanMs, all[f].spanMs) << f;
+      EXPECT_GT(one.workMs, 0.0) << f;
+    }
+    EXPECT_EQ(p.workSpan(frames + 3).workMs, 0.0);
+  }
+}
+
 TEST(Profiler, ZonesFromManyThreadsGoToATraceThatParses) {
   Profiler p;
   JobSystem jobs(4);

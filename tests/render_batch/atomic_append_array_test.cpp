@@ -78,6 +78,42 @@ TEST(AtomicAppendArray, OverflowIsRefusedAndReported) {
   EXPECT_EQ(array.size(), 1u);
 }
 
+TEST(AtomicAppendArray, BlocksFromManyThreadsAreKeptWholeAndOverflowIsCutAtCapacity) {
+  // Blocks of up to 64 (what the transform update hands over) from 4 threads: every accepted
+  // block lands contiguous; past capacity the block that straddles it keeps only what fits.
+  constexpr uint32_t kThreads = 4, kBlocks = 500, kBlock = 37;
+  for (const uint32_t capacity : {kThreads * kBlocks * kBlock, 40'000u}) {
+    AtomicAppendArray<Item> array(capacity);
+    std::vector<std::thread> team;
+    std::vector<uint32_t> wholeBlocks(kThreads, 0);
+    for (uint32_t t = 0; t < kThreads; ++t)
+      team.emplace_back([&, t] {
+        Item block[kBlock];
+        for (uint32_t b = 0; b < kBlocks; ++b) {
+          for (uint32_t k = 0; k < kBlock; ++k) block[k] = {t, b * kBlock + k};
+          wholeBlocks[t] += array.tryAppend(block, kBlock) ? 1 : 0;
+        }
+      });
+    for (auto& th : team) th.join();
+    EXPECT_EQ(array.attempted(), uint64_t(kThreads) * kBlocks * kBlock);
+    EXPECT_EQ(array.size(), std::min<uint32_t>(capacity, kThreads * kBlocks * kBlock));
+    EXPECT_EQ(array.overflowed(), capacity < kThreads * kBlocks * kBlock);
+    uint32_t accepted = 0;
+    for (uint32_t w : wholeBlocks) accepted += w;
+    EXPECT_EQ(accepted, capacity / kBlock) << "every block before the one that straddles the capacity fitted";
+    // Each stored item is unique, and items of one block sit next to each other in order.
+    std::vector<uint8_t> seen(kThreads * kBlocks * kBlock, 0);
+    for (uint32_t i = 0; i < array.size(); ++i) {
+      const Item& it = array[i];
+      ASSERT_EQ(seen[it.thread * kBlocks * kBlock + it.sequence]++, 0);
+      if (it.sequence % kBlock != 0 && i > 0) {
+        EXPECT_EQ(array[i - 1].thread, it.thread);
+        EXPECT_EQ(array[i - 1].sequence + 1, it.sequence);
+      }
+    }
+  }
+}
+
 TEST(AtomicAppendArray, ZeroCapacityRefusesEverything) {
   AtomicAppendArray<Item> array(0);
   EXPECT_FALSE(array.tryAppend({1, 2}));

@@ -53,6 +53,28 @@ TEST(SweepAndPrune, MatchesBruteForceWhileBodiesMove) {
   }
 }
 
+TEST(SweepAndPrune, BodiesThatJumpFarAreSortedInBulkWithTheSamePairs) {
+  // Half the bodies teleport every frame (respawned rubble, poses set from outside): the
+  // insertion sort gives up and sorts in bulk; the pairs must still equal brute force.
+  SeededRandom r(5);
+  const uint32_t n = 2000;
+  std::vector<WorldAabb> b(n);
+  std::vector<uint8_t> st(n, 0);
+  auto place = [&](uint32_t i) {
+    const Vec3d c(r.uniform(-50, 50), r.uniform(-50, 50), r.uniform(0, 20));
+    const Vec3d h = Vec3d::Constant(r.logUniform(0.2, 3));
+    b[i] = {c - h, c + h};
+  };
+  for (uint32_t i = 0; i < n; ++i) place(i);
+  SweepAndPrune sap;
+  std::vector<BodyPair> pairs;
+  for (int frame = 0; frame < 10; ++frame) {
+    sap.update(b, st, pairs);
+    ASSERT_EQ(pairs, bruteForce(b, st)) << "frame " << frame;
+    for (uint32_t i = frame % 2; i < n; i += 2) place(i);
+  }
+}
+
 TEST(SweepAndPrune, BadBoundsAreRejectedNamingTheBody) {
   SweepAndPrune sap;
   std::vector<BodyPair> pairs;

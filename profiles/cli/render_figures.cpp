@@ -1,0 +1,116 @@
+#include "cli/render_figures.h"
+
+#include <cstdio>
+
+namespace bw::cli {
+
+void RenderFigures::add(const RenderStageStats& r) {
+  update.v.push_back(r.updateMs);
+  submission.v.push_back(r.submissionMs);
+  commit.v.push_back(r.commitMs);
+  wait.v.push_back(r.waitMs);
+  gameThread.v.push_back(r.updateMs + r.submissionMs + r.commitMs);
+  primitives += r.primitives;
+  lights += r.lights;
+  movedBodies += r.movedBodies;
+  ++frames;
+}
+
+void RenderFigures::finish(World& world) {
+  sceneHash = world.renderScene().stateHash();
+  renderBusyMs = double(world.render()->renderStats().busyNanoseconds) * 1e-6;
+  spans = world.profiler().workSpans(frames);
+  renderStage = world.renderStage();
+  mode = world.render()->mode();
+}
+
+double RenderFigures::predictedMs(int threads, bool withUpdate) const {
+  double total = 0;
+  for (const WorkSpan& ws : spans) {
+    for (size_t s = 0; s < ws.stageIds.size(); ++s) {
+      const int offset = ws.stageIds[s] - renderStage;
+      if (offset < 0 || offset > kRenderCommitStage) continue;
+      const RenderStageKind kind = renderStageKind(offset);
+      const bool counted = kind == RenderStageKind::Submission || kind == RenderStageKind::Commit || withUpdate;
+      if (counted) total += std::max(ws.stageWorkMs[s] / threads, ws.stageSpanMs[s]);
+    }
+  }
+  return spans.empty() ? 0 : total / double(spans.size());
+}
+
+nlohmann::json RenderFigures::json(const World& world) const {
+  const WorldRender& r = *world.render();
+  nlohmann::json j{{"submission", submissionModeName(r.mode())},
+                   {"attachments", r.store().size()},
+                   {"primitives", r.store().primitiveCount()},
+                   {"lights", r.store().lightCount()},
+                   {"moved_bodies_per_frame", double(movedBodies) / frames},
+                   {"primitive_records_per_frame", double(primitives) / frames},
+                   {"light_records_per_frame", double(lights) / frames},
+                   {"transform_update", update.json()},
+                   {"submission_stage", submission.json()},
+                   {"commit", commit.json()},
+                   {"wait_for_render_thread", wait.json()},
+                   {"game_thread_submission_commit_ms_per_frame", (submission.sum() + commit.sum()) / frames},
+                   {"render_thread_busy_ms_per_frame", renderBusyMs / frames},
+                   {"render_scene_hash", sceneHash}};
+  for (int p : {1, 2, 4, 8, 16}) j["predicted_submission_commit_ms"][std::to_string(p)] = predictedMs(p);
+  return j;
+}
+
+void RenderFigures::print(const World& world) const {
+  const WorldRender& r = *world.render();
+  std::printf("  render (%s submission): %u attachments (%u primitives, %u lights); per frame %.0f bodies moved, %.0f + %.0f records\n",
+              submissionModeName(r.mode()), r.store().size(), r.store().primitiveCount(), r.store().lightCount(),
+              double(movedBodies) / frames, double(primitives) / frames, double(lights) / frames);
+  for (auto [name, s] : {std::pair<const char*, const Series*>{"transform", &update}, {"submission", &submission}, {"commit", &commit},
+                         {"render wait", &wait}})
+    std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
+  std::printf("  render thread busy %.3f ms per frame; render scene hash %016llx\n", renderBusyMs / frames,
+              (unsigned long long)sceneHash);
+  std::printf("  submission + commit predicted at 1/2/4/8/16 threads: %.3f %.3f %.3f %.3f %.3f ms per frame\n", predictedMs(1),
+              predictedMs(2), predictedMs(4), predictedMs(8), predictedMs(16));
+}
+
+bool compareSubmissionModes(const SceneDescription& scene, int threads, uint32_t frames, World& batchedWorld,
+                            const RenderFigures& batched, bool json, nlohmann::json& out) {
+  bool same = true;
+  const double batchedGame = (batched.submission.sum() + batched.commit.sum()) / frames;
+  if (!json) std::printf("submission modes from the same initial state (%d thread(s), %u frames):\n", threads, frames);
+  if (!json)
+    std::printf("  %-28s %14s %14s %14s %18s  %s\n", "mode", "submit+commit", "at 16 threads", "render busy", "vs batched (16 thr)",
+                "render scene hash");
+  auto row = [&](const char* mode, const RenderFigures& f) {
+    const double game = (f.submission.sum() + f.commit.sum()) / frames;
+    const double p16 = f.predictedMs(16);
+    const double ratio = p16 / std::max(batched.predictedMs(16), 1e-9);
+    if (json) {
+      out[mode] = {{"submission_commit_ms_per_frame", game},
+                   {"predicted_submission_commit_ms_16_threads", p16},
+                   {"render_thread_busy_ms_per_frame", f.renderBusyMs / frames},
+                   {"over_batched_measured", game / std::max(batchedGame, 1e-9)},
+                   {"over_batched_predicted_16_threads", ratio},
+                   {"render_scene_hash", f.sceneHash}};
+    } else {
+      std::printf("  %-28s %11.3f ms %11.3f ms %11.3f ms %8.2fx / %5.2fx  %016llx\n", mode, game, p16, f.renderBusyMs / frames,
+                  game / std::max(batchedGame, 1e-9), ratio, (unsigned long long)f.sceneHash);
+    }
+  };
+  row(submissionModeName(SubmissionMode::Batched), batched);
+  for (SubmissionMode mode : {SubmissionMode::PerObjectMutexNoRadius, SubmissionMode::PerObjectConcurrentNoRadius}) {
+    World world(scene, threads, mode);
+    RenderFigures f;
+    for (uint32_t k = 0; k < frames; ++k) {
+      world.step();
+      f.add(world.lastStats().render);
+    }
+    f.finish(world);
+    row(submissionModeName(mode), f);
+    same = same && f.sceneHash == batched.sceneHash && world.stateHash() == batchedWorld.stateHash();
+  }
+  if (json) out["render_scene_hashes_equal"] = same;
+  else std::printf("  render scene hashes and state hashes %s across modes\n", same ? "identical" : "DIFFER");
+  return same;
+}
+
+}  // namespace bw::cli

@@ -1,0 +1,145 @@
+#include "world/world_render.h"
+
+#include <chrono>
+#include <cstring>
+
+#include "collision/core/argument_checks.h"
+
+namespace bw {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// Bodies per chunk of the pose pass (a pose is ~60 flops: large chunks amortise scheduling).
+constexpr uint32_t kPoseGrain = 2048;
+
+uint32_t batchSize(uint32_t asked, uint32_t all) { return asked == 0 ? all : asked; }
+
+}  // namespace
+
+WorldRender::WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bodyCount, uint32_t batchPrimitives,
+                         uint32_t batchLights)
+    : store_(std::move(store)),
+      position_(bodyCount, Vec3d::Zero()),
+      rotation_(bodyCount, Quatf::Identity()),
+      moved_(bodyCount, 0),
+      asleepBefore_(bodyCount, 0),
+      movedPerChunk_(JobSystem::chunkCount(0, bodyCount, kPoseGrain), 0) {
+  if (store_.bodiesReferenced() > bodyCount)
+    throw InvalidInput("WorldRender: attachments ride on " + std::to_string(store_.bodiesReferenced()) + " bodies, the world has " +
+                       std::to_string(bodyCount));
+  pipeline_ = std::make_unique<RenderFramePipeline>(store_, mode, RenderThread::FenceObserver{},
+                                                    batchSize(batchPrimitives, store_.primitiveCount()),
+                                                    batchSize(batchLights, store_.lightCount()));
+  // One timing slot per update chunk of every level, laid out once (the store no longer changes).
+  store_.prepareUpdateOrder();
+  uint32_t chunks = 0;
+  for (uint32_t level = 0; level < store_.levelCount(); ++level) {
+    levelFirstChunk_.push_back(chunks);
+    chunks += JobSystem::chunkCount(store_.levelBegin(level), store_.levelBegin(level + 1), TransformUpdate::kDefaultGrain);
+  }
+  chunkTimes_.resize(chunks);
+}
+
+uint32_t WorldRender::markMovedBodies(const BodyStore& bodies, const SleepState& sleep, JobSystem& jobs, Profiler& profiler,
+                                      int stage) {
+  const uint32_t n = uint32_t(position_.size());
+  const bool all = checkAll_;
+  jobs.parallelFor(0, n, kPoseGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "render poses", stage);
+    uint32_t moved = 0;
+    for (uint32_t i = begin; i < end; ++i) {
+      moved_[i] = 0;
+      // A body that fell asleep this frame still moved in it: it is skipped only from the
+      // frame after (its pose is then the one submitted last).
+      const bool asleep = sleep.asleep(i);
+      const bool wasAsleep = asleepBefore_[i] != 0;
+      asleepBefore_[i] = asleep ? 1 : 0;
+      if (!all && (bodies.motion[i] == MotionType::Static || (asleep && wasAsleep))) continue;
+      const RigidTransform pose = bodies.shapePose(i);
+      // note: bits, not values: a pose that changed by one ulp moved (the render scene must
+      // equal the world's poses exactly), and -0.0 vs 0.0 is a change we can afford to send.
+      if (std::memcmp(&pose.translation, &position_[i], sizeof(Vec3d)) == 0 &&
+          std::memcmp(&pose.rotation, &rotation_[i], sizeof(Quatf)) == 0)
+        continue;
+      position_[i] = pose.translation;
+      rotation_[i] = pose.rotation;
+      moved_[i] = 1;
+      ++moved;
+    }
+    movedPerChunk_[begin / kPoseGrain] = moved;
+  });
+  checkAll_ = false;
+  uint32_t total = 0;
+  for (uint32_t m : movedPerChunk_) total += m;
+  return total;
+}
+
+RenderStageStats WorldRender::run(const BodyStore& bodies, const SleepState& sleep, JobSystem& jobs, Profiler& profiler, int stage) {
+  if (bodies.size() != position_.size())
+    throw InvalidInput("WorldRender::run: the world has " + std::to_string(bodies.size()) + " bodies, the render was built for " +
+                       std::to_string(position_.size()));
+  RenderStageStats stats;
+  const auto poseStart = Clock::now();
+  stats.movedBodies = markMovedBodies(bodies, sleep, jobs, profiler, stage);
+  const double poseMs = msSince(poseStart);
+
+  for (UpdateRangeTimes& t : chunkTimes_) t = UpdateRangeTimes{};
+  const bool serialSubmission = pipeline_->mode() == SubmissionMode::PerObjectMutex ||
+                                pipeline_->mode() == SubmissionMode::PerObjectMutexNoRadius;
+  double sectionMs = 0;
+  const BodyPoseView view{position_.data(), rotation_.data(), moved_.data(), uint32_t(position_.size())};
+  const auto runner = [&](TransformUpdate& update) {
+    const auto start = Clock::now();
+    for (uint32_t level = 0; level < update.levelCount(); ++level) {
+      const uint32_t first = update.levelBegin(level);
+      const uint32_t chunk0 = levelFirstChunk_[level];
+      const int32_t updateStage = stage + 1 + 2 * int32_t(level);
+      jobs.parallelFor(first, update.levelEnd(level), TransformUpdate::kDefaultGrain, [&](uint32_t b, uint32_t e) {
+        UpdateRangeTimes& t = chunkTimes_[chunk0 + (b - first) / TransformUpdate::kDefaultGrain];
+        const int64_t zoneStart = profiler.enabled() ? profiler.now() : 0;
+        update.runRangeTimed(b, e, t);
+        if (profiler.enabled()) {
+          // The chunk's two halves as two zones back to back (they interleave block by block).
+          profiler.record("transform update", zoneStart, zoneStart + t.updateNs, updateStage);
+          profiler.record("submission", zoneStart + t.updateNs, zoneStart + t.updateNs + t.submitNs, updateStage + 1,
+                          serialSubmission);
+        }
+      });
+    }
+    sectionMs = msSince(start);
+  };
+  FrameTiming timing;
+  try {
+    timing = pipeline_->runFrame(view, runner);
+  } catch (const CapacityExceeded&) {
+    // The frame was fenced without its batch: the render scene still shows the frame before.
+    // Resending everything next frame brings it up to date in one step.
+    store_.markAllDirty();
+    throw;
+  }
+  if (profiler.enabled()) {
+    const int64_t end = profiler.now();
+    profiler.record("commit", end - int64_t(timing.commitMs * 1e6), end, stage + kRenderCommitStage, true);
+  }
+  int64_t updateNs = 0, submitNs = 0;
+  for (const UpdateRangeTimes& t : chunkTimes_) {
+    updateNs += t.updateNs;
+    submitNs += t.submitNs;
+    stats.primitives += t.primitives;
+    stats.lights += t.lights;
+  }
+  const double share = updateNs + submitNs > 0 ? double(updateNs) / double(updateNs + submitNs) : 1.0;
+  stats.updateMs = poseMs + sectionMs * share;
+  stats.submissionMs = sectionMs * (1.0 - share);
+  stats.commitMs = timing.commitMs;
+  stats.waitMs = timing.waitMs;
+  const uint64_t busy = renderStats().busyNanoseconds;
+  stats.renderBusyMs = double(busy - reportedBusyNs_) * 1e-6;
+  reportedBusyNs_ = busy;
+  return stats;
+}
+
+}  // namespace bw
