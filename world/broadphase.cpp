@@ -7,6 +7,17 @@
 
 namespace bw {
 
+// Sorts (min on the axis, id) pairs held by value: the comparisons read a contiguous array
+// instead of jumping through the ids into the bounds (1M bodies: several times faster).
+void SweepAndPrune::sortInBulk(const std::vector<WorldAabb>& bounds) {
+  const uint32_t n = uint32_t(bounds.size());
+  keys_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) keys_[i] = {bounds[i].min[axis_], i};
+  std::sort(keys_.begin(), keys_.end());
+  order_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) order_[i] = keys_[i].second;
+}
+
 void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic,
                            std::vector<BodyPair>& pairs) {
   const uint32_t n = uint32_t(bounds.size());
@@ -44,9 +55,7 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
     // No order to start from (the first frame, a new axis, bodies added): sort in bulk,
     // O(n log n), where an insertion sort from scratch is quadratic (100k bodies: seconds).
     axis_ = axis;
-    order_.resize(n);
-    for (uint32_t i = 0; i < n; ++i) order_[i] = i;
-    std::sort(order_.begin(), order_.end(), less);
+    sortInBulk(bounds);
   } else {
     // Insertion sort from last frame's order: near-linear for coherent motion. When bodies
     // jumped far (more than a few moves per body), it gives up and sorts in bulk.
@@ -62,7 +71,7 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
       order_[j] = v;
       moves += i - j;
     }
-    if (moves > budget) std::sort(order_.begin(), order_.end(), less);
+    if (moves > budget) sortInBulk(bounds);
   }
   const int a1 = (axis_ + 1) % 3, a2 = (axis_ + 2) % 3;
   sorted_.resize(n);

@@ -12,6 +12,7 @@
 /// order or on thread count.
 /// Thread safety: one thread; call update() between steps.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "collision/core/math_types.h"
@@ -45,7 +46,10 @@ class SweepAndPrune {
   uint64_t lastTests() const { return tests_; }
 
  private:
+  void sortInBulk(const std::vector<WorldAabb>& bounds);
+
   std::vector<uint32_t> order_;  // body ids sorted by min on axis_, kept between frames
+  std::vector<std::pair<double, uint32_t>> keys_;  // sortInBulk scratch
   // The bounds in that order, copied each update: the sweep then reads memory in order instead
   // of jumping through order_ (the pile of a landing rain overlaps dozens of bodies per body).
   struct Sorted {
