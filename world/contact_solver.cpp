@@ -28,94 +28,113 @@ void clampToFrictionCone(float t1, float t2, float limit, float& out1, float& ou
 }
 }  // namespace
 
-void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs,
-                            const std::vector<std::vector<Contact>>& pairContacts, const std::vector<uint8_t>& flipped,
-                            const SceneSettings& settings, float dt) {
-  contacts_.clear();
-  inverseInertiaWorld_.resize(bodies.size());
-  for (uint32_t i = 0; i < bodies.size(); ++i) inverseInertiaWorld_[i] = bodies.inverseInertiaWorld(i);
-  for (uint32_t k = 0; k < pairs.size(); ++k) {
-    // Solver convention: the normal points from b towards a.
-    const uint32_t a = flipped[k] ? pairs[k].b : pairs[k].a;
-    const uint32_t b = flipped[k] ? pairs[k].a : pairs[k].b;
-    for (const Contact& c : pairContacts[k]) {
-      SolverContact s;
-      s.a = a;
-      s.b = b;
-      s.point = c.position;
-      s.normal = c.normal;
-      s.depth = c.depth;
-      s.pairKey = (uint64_t(pairs[k].a) << 32) | pairs[k].b;
-      s.feature = c.featureB;
-      s.rA = (c.position - bodies.position[a]).cast<float>();
-      s.rB = (c.position - bodies.position[b]).cast<float>();
-      const Vec3f n = s.normal;
-      s.t1 = (std::abs(n.x()) > kTangentThreshold ? Vec3f(n.y(), -n.x(), 0) : Vec3f(0, n.z(), -n.y())).normalized();
-      s.t2 = n.cross(s.t1);
-      const Mat3f& iA = inverseInertiaWorld_[a];
-      const Mat3f& iB = inverseInertiaWorld_[b];
-      const Vec3f dirs[3] = {n, s.t1, s.t2};
-      float masses[3];
+// One solver contact from contact c of a pair whose solver bodies are a and b (the normal points
+// from b towards a).
+SolverContact ContactSolver::makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c,
+                                         const SceneSettings& settings, float dt) const {
+  SolverContact s;
+  s.a = a;
+  s.b = b;
+  s.point = c.position;
+  s.normal = c.normal;
+  s.depth = c.depth;
+  s.pairKey = (uint64_t(pair.a) << 32) | pair.b;
+  s.feature = c.featureB;
+  s.rA = (c.position - bodies.position[a]).cast<float>();
+  s.rB = (c.position - bodies.position[b]).cast<float>();
+  const Vec3f n = s.normal;
+  s.t1 = (std::abs(n.x()) > kTangentThreshold ? Vec3f(n.y(), -n.x(), 0) : Vec3f(0, n.z(), -n.y())).normalized();
+  s.t2 = n.cross(s.t1);
+  const Mat3f& iA = inverseInertiaWorld_[a];
+  const Mat3f& iB = inverseInertiaWorld_[b];
+  const Vec3f dirs[3] = {n, s.t1, s.t2};
+  float masses[3];
+  for (int d = 0; d < 3; ++d) {
+    s.angA[d] = iA * s.rA.cross(dirs[d]);
+    s.angB[d] = iB * s.rB.cross(dirs[d]);
+    const float m = bodies.inverseMass[a] + bodies.inverseMass[b] + s.angA[d].cross(s.rA).dot(dirs[d]) +
+                    s.angB[d].cross(s.rB).dot(dirs[d]);
+    masses[d] = m > 0 ? 1.f / m : 0.f;
+  }
+  s.massN = masses[0];
+  s.massT1 = masses[1];
+  s.massT2 = masses[2];
+  if (settings.shockPropagation && bodies.motion[a] == MotionType::Dynamic && bodies.motion[b] == MotionType::Dynamic) {
+    // The lower body (along gravity) is the support: in the shock sweep only the upper one moves.
+    const Vec3d up = -settings.gravity.normalized();
+    const double ha = up.dot(bodies.position[a]), hb = up.dot(bodies.position[b]);
+    if (std::isfinite(ha) && std::abs(ha - hb) > kShockHeightEpsilon) {
+      s.shockLower = ha < hb ? 1 : 2;
+      s.height = std::min(ha, hb);
       for (int d = 0; d < 3; ++d) {
-        s.angA[d] = iA * s.rA.cross(dirs[d]);
-        s.angB[d] = iB * s.rB.cross(dirs[d]);
-        const float m = bodies.inverseMass[a] + bodies.inverseMass[b] + s.angA[d].cross(s.rA).dot(dirs[d]) +
-                        s.angB[d].cross(s.rB).dot(dirs[d]);
-        masses[d] = m > 0 ? 1.f / m : 0.f;
+        const float m = s.shockLower == 1 ? bodies.inverseMass[b] + s.angB[d].cross(s.rB).dot(dirs[d])
+                                          : bodies.inverseMass[a] + s.angA[d].cross(s.rA).dot(dirs[d]);
+        s.shockMass[d] = m > 0 ? 1.f / m : 0.f;
       }
-      s.massN = masses[0];
-      s.massT1 = masses[1];
-      s.massT2 = masses[2];
-      if (settings.shockPropagation && bodies.motion[a] == MotionType::Dynamic && bodies.motion[b] == MotionType::Dynamic) {
-        // The lower body (along gravity) is the support: in the shock sweep only the upper one moves.
-        const Vec3d up = -settings.gravity.normalized();
-        const double ha = up.dot(bodies.position[a]), hb = up.dot(bodies.position[b]);
-        if (std::isfinite(ha) && std::abs(ha - hb) > kShockHeightEpsilon) {
-          s.shockLower = ha < hb ? 1 : 2;
-          s.height = std::min(ha, hb);
-          for (int d = 0; d < 3; ++d) {
-            const float m = s.shockLower == 1 ? bodies.inverseMass[b] + s.angB[d].cross(s.rB).dot(dirs[d])
-                                              : bodies.inverseMass[a] + s.angA[d].cross(s.rA).dot(dirs[d]);
-            s.shockMass[d] = m > 0 ? 1.f / m : 0.f;
-          }
-        }
-      }
-      s.friction = std::sqrt(bodies.friction[a] * bodies.friction[b]);
-      s.rolling = settings.rollingResistance * std::max(rollingRadius(bodies.shape[a]), rollingRadius(bodies.shape[b]));
-      if (s.rolling > 0.f)
-        for (int d = 0; d < 2; ++d) {
-          const Vec3f axis = d == 0 ? s.t1 : s.t2;
-          s.rollA[d] = iA * axis;
-          s.rollB[d] = iB * axis;
-          const float m = axis.dot(s.rollA[d]) + axis.dot(s.rollB[d]);
-          s.massR[d] = m > 0 ? 1.f / m : 0.f;
-        }
-      const Vec3f vRel = bodies.linearVelocity[a] + bodies.angularVelocity[a].cross(s.rA) - bodies.linearVelocity[b] -
-                         bodies.angularVelocity[b].cross(s.rB);
-      const float vn = vRel.dot(n);
-      // Penetrating: push out (Baumgarte) and restitute fast impacts. Speculative (a gap of -depth):
-      // the bodies may approach by at most the gap this step.
-      const float bounce = vn < -kBounceThreshold ? -kRestitution * vn : 0.f;
-      s.bias = s.depth >= 0.f ? std::min(kBaumgarte / dt * std::max(s.depth - kSlop, 0.f), kMaxPushOut) + bounce : s.depth / dt;
-      // The relax pass after integration keeps restitution and speculative gaps but drops the
-      // push-out, so no push-out velocity survives into the next step (resting stacks stay put).
-      s.relaxBias = s.depth >= 0.f ? bounce : s.depth / dt;
-      // Warm start from the nearest cached impulse of the same pair and feature.
-      const CachedImpulse key{s.pairKey, s.feature, {}, 0, 0, 0};
-      auto range = std::equal_range(cache_.begin(), cache_.end(), key);
-      double best = kWarmStartRadius * kWarmStartRadius;
-      for (auto it = range.first; it != range.second; ++it) {
-        const double d2 = (it->point - s.point).squaredNorm();
-        if (d2 < best) {
-          best = d2;
-          s.lambdaN = it->n;
-          s.lambdaT1 = it->t1;
-          s.lambdaT2 = it->t2;
-        }
-      }
-      contacts_.push_back(s);
     }
   }
+  s.friction = std::sqrt(bodies.friction[a] * bodies.friction[b]);
+  s.rolling = settings.rollingResistance * std::max(rollingRadius(bodies.shape[a]), rollingRadius(bodies.shape[b]));
+  if (s.rolling > 0.f)
+    for (int d = 0; d < 2; ++d) {
+      const Vec3f axis = d == 0 ? s.t1 : s.t2;
+      s.rollA[d] = iA * axis;
+      s.rollB[d] = iB * axis;
+      const float m = axis.dot(s.rollA[d]) + axis.dot(s.rollB[d]);
+      s.massR[d] = m > 0 ? 1.f / m : 0.f;
+    }
+  const Vec3f vRel = bodies.linearVelocity[a] + bodies.angularVelocity[a].cross(s.rA) - bodies.linearVelocity[b] -
+                     bodies.angularVelocity[b].cross(s.rB);
+  const float vn = vRel.dot(n);
+  // Penetrating: push out (Baumgarte) and restitute fast impacts. Speculative (a gap of -depth):
+  // the bodies may approach by at most the gap this step.
+  const float bounce = vn < -kBounceThreshold ? -kRestitution * vn : 0.f;
+  s.bias = s.depth >= 0.f ? std::min(kBaumgarte / dt * std::max(s.depth - kSlop, 0.f), kMaxPushOut) + bounce : s.depth / dt;
+  // The relax pass after integration keeps restitution and speculative gaps but drops the
+  // push-out, so no push-out velocity survives into the next step (resting stacks stay put).
+  s.relaxBias = s.depth >= 0.f ? bounce : s.depth / dt;
+  // Warm start from the nearest cached impulse of the same pair and feature.
+  const CachedImpulse key{s.pairKey, s.feature, {}, 0, 0, 0};
+  auto range = std::equal_range(cache_.begin(), cache_.end(), key);
+  double best = kWarmStartRadius * kWarmStartRadius;
+  for (auto it = range.first; it != range.second; ++it) {
+    const double d2 = (it->point - s.point).squaredNorm();
+    if (d2 < best) {
+      best = d2;
+      s.lambdaN = it->n;
+      s.lambdaT1 = it->t1;
+      s.lambdaT2 = it->t2;
+    }
+  }
+  return s;
+}
+
+void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs,
+                            const std::vector<std::vector<Contact>>& pairContacts, const std::vector<uint8_t>& flipped,
+                            const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler, int stage) {
+  const uint32_t n = bodies.size();
+  inverseInertiaWorld_.resize(n);
+  jobs.parallelFor(0, n, tuning::kBodyGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "prepare: inertia", stage);
+    for (uint32_t i = begin; i < end; ++i) inverseInertiaWorld_[i] = bodies.inverseInertiaWorld(i);
+  });
+  // Pair k's contacts go to [first_[k], first_[k + 1]): every pair fills its own range, in
+  // parallel, in the order a serial loop would (the same list for any thread count).
+  const uint32_t pairCount = uint32_t(pairs.size());
+  first_.resize(pairCount + 1);
+  first_[0] = 0;
+  for (uint32_t k = 0; k < pairCount; ++k) first_[k + 1] = first_[k] + uint32_t(pairContacts[k].size());
+  contacts_.resize(first_[pairCount]);
+  jobs.parallelFor(0, pairCount, kPrepareGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "prepare: contacts", stage + 1);
+    for (uint32_t k = begin; k < end; ++k) {
+      // Solver convention: the normal points from b towards a.
+      const uint32_t a = flipped[k] ? pairs[k].b : pairs[k].a;
+      const uint32_t b = flipped[k] ? pairs[k].a : pairs[k].b;
+      uint32_t slot = first_[k];
+      for (const Contact& c : pairContacts[k]) contacts_[slot++] = makeContact(bodies, pairs[k], a, b, c, settings, dt);
+    }
+  });
 }
 
 // Applies impulse `lambda` along direction d (0 normal, 1 and 2 tangents) to the contact's

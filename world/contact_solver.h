@@ -5,7 +5,7 @@
 /// pass without push-out. Islands are solved in parallel; a large island colour by colour on
 /// every thread. The result does not depend on the thread count.
 ///
-///   solver.prepare(bodies, pairs, pairContacts, flipped, settings, dt);
+///   solver.prepare(bodies, pairs, pairContacts, flipped, settings, dt, jobs, profiler, stage);
 ///   islands.build(solver.contacts(), bodies.motion);
 ///   solver.loadBodies(bodies); solver.solve(islands, false, ...); solver.storeBodies(bodies);
 #include <cstdint>
@@ -32,9 +32,12 @@ class ContactSolver {
  public:
   /// This substep's solver contacts from the pairs' contacts (pair k's normals point from the
   /// pair's a side to its b side unless flipped[k]), with effective masses, biases and the
-  /// warm-start impulses of the previous substep.
+  /// warm-start impulses of the previous substep. Parallel on jobs (zones at stage: world
+  /// inertia per body, stage + 1: contacts per pair, each pair writing its own range), the same
+  /// list in the same order for any thread count.
   void prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs, const std::vector<std::vector<Contact>>& pairContacts,
-               const std::vector<uint8_t>& flipped, const SceneSettings& settings, float dt);
+               const std::vector<uint8_t>& flipped, const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler,
+               int stage);
   const std::vector<SolverContact>& contacts() const { return contacts_; }
 
   /// Copies the bodies' velocities into the solver's compact records, and back (dynamic only).
@@ -49,6 +52,10 @@ class ContactSolver {
                    JobSystem& jobs, Profiler& profiler, int stage);
 
  private:
+  /// Pairs per job of prepare(): a contact costs ~100 ns, a pair up to manifoldSize of them.
+  static constexpr uint32_t kPrepareGrain = 256;
+  SolverContact makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c,
+                            const SceneSettings& settings, float dt) const;
   void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
   void warmStart(const SolverContact& s);
   void solveContact(SolverContact& s, bool relax);
@@ -62,6 +69,7 @@ class ContactSolver {
   std::vector<SolverContact> contacts_;
   std::vector<SolverBody> bodies_;
   std::vector<Mat3f> inverseInertiaWorld_;  // per body, this substep
+  std::vector<uint32_t> first_;             // prepare(): pair k's contacts start at first_[k]
   std::vector<CachedImpulse> cache_, nextCache_;
   std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
   IslandColouring colouring_;               // of the large island being solved

@@ -1,6 +1,7 @@
 #include "world/islands.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 
 #include "collision/core/ids.h"
@@ -13,15 +14,53 @@ uint32_t Islands::find(uint32_t x) {
   return x;
 }
 
-void Islands::build(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion) {
+namespace {
+
+uint32_t loadParent(std::vector<uint32_t>& parent, uint32_t x) {
+  return std::atomic_ref<uint32_t>(parent[x]).load(std::memory_order_relaxed);
+}
+
+// The root of x while other threads link roots (every link goes from a root to a smaller root,
+// so the walk ends).
+uint32_t findConcurrent(std::vector<uint32_t>& parent, uint32_t x) {
+  for (uint32_t p = loadParent(parent, x); p != x; p = loadParent(parent, x)) x = p;
+  return x;
+}
+
+}  // namespace
+
+void Islands::build(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs,
+                    Profiler& profiler, int stage) {
   const uint32_t n = uint32_t(motion.size());
   parent_.resize(n);
   for (uint32_t i = 0; i < n; ++i) parent_[i] = i;
-  for (const SolverContact& c : contacts) {
-    if (motion[c.a] != MotionType::Dynamic || motion[c.b] != MotionType::Dynamic) continue;
-    const uint32_t ra = find(c.a), rb = find(c.b);
-    if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
-  }
+  // Union-find over the contacts in parallel: a link always hangs the larger of two roots under
+  // the smaller (compare-and-swap on the larger, which must still be a root), so every island's
+  // root is its smallest body id whatever the order the links were made in: the grouping is a
+  // pure function of the contact list, for any thread count.
+  jobs.parallelFor(0, uint32_t(contacts.size()), tuning::kIslandGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "islands: union", stage);
+    for (uint32_t k = begin; k < end; ++k) {
+      const SolverContact& c = contacts[k];
+      if (motion[c.a] != MotionType::Dynamic || motion[c.b] != MotionType::Dynamic) continue;
+      for (;;) {
+        uint32_t ra = findConcurrent(parent_, c.a), rb = findConcurrent(parent_, c.b);
+        if (ra == rb) break;
+        if (ra > rb) std::swap(ra, rb);
+        uint32_t expected = rb;
+        if (std::atomic_ref<uint32_t>(parent_[rb]).compare_exchange_strong(expected, ra, std::memory_order_relaxed)) break;
+      }
+    }
+  });
+  // Every body points straight at its root (after the join, so no link is still being made).
+  jobs.parallelFor(0, n, tuning::kBodyGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "islands: flatten", stage + 1);
+    for (uint32_t i = begin; i < end; ++i) std::atomic_ref<uint32_t>(parent_[i]).store(findConcurrent(parent_, i), std::memory_order_relaxed);
+  });
+}
+
+void Islands::groupContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion) {
+  const uint32_t n = uint32_t(motion.size());
   // Contacts grouped by the island of their dynamic body, islands ordered by root id (CSR).
   rootIndex_.assign(n, kInvalidIndex);
   roots_.clear();

@@ -6,6 +6,8 @@
 #include <span>
 #include <vector>
 
+#include "jobs/job_system.h"
+#include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/solver_contact.h"
 
@@ -13,9 +15,14 @@ namespace bw {
 
 class Islands {
  public:
-  /// Groups the contacts by island (CSR, islands ordered by their root body). Union-find with
-  /// the smaller id as root makes the grouping a pure function of the contact list.
-  void build(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion);
+  /// Finds the islands, then groupContacts() groups the contacts by island (CSR, islands
+  /// ordered by their root body). Union-find with
+  /// the smaller id as root, run over the contacts in parallel on jobs (zones at stage, stage + 1),
+  /// makes the grouping a pure function of the contact list.
+  void build(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs, Profiler& profiler,
+             int stage);
+  /// Then the contacts grouped by island (one pass over the contacts, serial).
+  void groupContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion);
 
   uint32_t count() const { return uint32_t(start_.size() - 1); }
   /// Indices into the contact list of island i's contacts, in contact order.

@@ -95,12 +95,16 @@ void World::substep(float dt, int index) {
   stats_.contactsMs += msSince(t);
   t = Clock::now();
   {
+    solver_.prepare(bodies_, pairs_, pairContacts_, pairFlipped_, scene_.settings, dt, jobs_, profiler_, stage + 9);
     {
-      ProfileZone z(profiler_, "prepare solver", stage + 2);
-      solver_.prepare(bodies_, pairs_, pairContacts_, pairFlipped_, scene_.settings, dt);
+      ProfileZone z(profiler_, "wake touched", stage + 2);
       // A sleeping body touched by an awake one wakes up (its island rejoins the simulation).
       sleep_.wakeTouched(solver_.contacts());
-      islands_.build(solver_.contacts(), bodies_.motion);
+    }
+    islands_.build(solver_.contacts(), bodies_.motion, jobs_, profiler_, stage + 11);
+    {
+      ProfileZone z(profiler_, "islands: group contacts", stage + 13);
+      islands_.groupContacts(solver_.contacts(), bodies_.motion);
     }
     ProfileZone z(profiler_, "solve (stage)");
     solver_.loadBodies(bodies_);

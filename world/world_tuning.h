@@ -12,6 +12,8 @@ inline constexpr float kDefaultFriction = 0.6f;
 /// of nanoseconds, so 1024 of them amortise a job's scheduling and still give 16 threads work
 /// from 16k bodies on.
 inline constexpr uint32_t kBodyGrain = 1024;
+/// Contacts per job of the islands' union-find (a union is a few loads and one compare-and-swap).
+inline constexpr uint32_t kIslandGrain = 2048;
 
 // --- Broadphase and speculative contacts --------------------------------------------------
 /// Body bounds grow by this (m) beyond how far the body can move in one frame, so resting

@@ -29,9 +29,10 @@ void solveOnce(ContactSolver& solver, BodyStore& bodies, const std::vector<BodyP
     contacts.push_back({Contact{under, Vec3f::UnitZ(), 0.001f, features[k], 0}});
   }
   const std::vector<uint8_t> flipped(pairs.size(), 1);  // normal from the ground (a) to the box (b)
-  solver.prepare(bodies, pairs, contacts, flipped, settings, 1.f / 60);
+  solver.prepare(bodies, pairs, contacts, flipped, settings, 1.f / 60, jobs, profiler, 0);
   Islands islands;
-  islands.build(solver.contacts(), bodies.motion);
+  islands.build(solver.contacts(), bodies.motion, jobs, profiler, 0);
+  islands.groupContacts(solver.contacts(), bodies.motion);
   solver.loadBodies(bodies);
   solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
   solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);
@@ -56,7 +57,7 @@ TEST(ContactSolver, WarmStartMatchesPairAndFeatureAtFullWidth) {
   const std::vector<BodyPair> pairs = {{0, 1}, {0, 2}};
   std::vector<std::vector<Contact>> contacts = {{Contact{Vec3d(0, 0, 0), Vec3f::UnitZ(), 0.001f, 0u, 0}},
                                                 {Contact{Vec3d(0, 0, 0), Vec3f::UnitZ(), 0.001f, 3u << 20, 0}}};
-  solver.prepare(bodies, pairs, contacts, std::vector<uint8_t>(2, 1), settings, 1.f / 60);
+  solver.prepare(bodies, pairs, contacts, std::vector<uint8_t>(2, 1), settings, 1.f / 60, jobs, profiler, 0);
   ASSERT_EQ(solver.contacts().size(), 2u);
   EXPECT_GT(solver.contacts()[0].lambdaN, 0.f) << "same pair and feature: warm-started";
   EXPECT_EQ(solver.contacts()[1].lambdaN, 0.f) << "another pair whose packed key would collide: cold";
@@ -75,7 +76,7 @@ TEST(ContactSolver, WarmStartKeepsFeaturesAboveTwoToTheTwentyApart) {
   SceneSettings settings;
   const Vec3d under = bodies.position[1] - Vec3d(0, 0, 0.5);
   std::vector<std::vector<Contact>> contacts = {{Contact{under, Vec3f::UnitZ(), 0.001f, 5u + (1u << 20), 0}}};
-  solver.prepare(bodies, {{0, 1}}, contacts, std::vector<uint8_t>(1, 1), settings, 1.f / 60);
+  solver.prepare(bodies, {{0, 1}}, contacts, std::vector<uint8_t>(1, 1), settings, 1.f / 60, jobs, profiler, 0);
   EXPECT_EQ(solver.contacts()[0].lambdaN, 0.f);
 }
 
