@@ -1,7 +1,9 @@
 #pragma once
 /// The world: bodies built from a scene, stepped as broadphase -> contacts per pair (parallel,
 /// one slot per pair) -> sequential-impulse solve -> integration, on a JobSystem with a chosen
-/// thread count. Results do not depend on the thread count (see stateHash()).
+/// thread count, then (scenes with attachments) the render frame: transform update, submission
+/// and commit to a render thread (world_render.h). Results do not depend on the thread count
+/// (see stateHash()).
 ///
 ///   bw::World world(bw::loadScene("profiles/scenes/crates_on_grid.json"), /*threads*/ 2);
 ///   for (int f = 0; f < 300; ++f) world.step();
@@ -13,7 +15,8 @@
 /// speculative margins, a pair cache, a sequential-impulse solver (friction, restitution, warm
 /// starting matched by contact feature, a relax pass after integration), islands solved in
 /// parallel, islands above kSplitContacts coloured (no two contacts of a colour share a dynamic
-/// body) and solved colour by colour on every thread, sleeping, and substeps. Terrain pairs run
+/// body) and solved colour by colour on every thread, sleeping, and substeps; per-body stages,
+/// solver preparation and island building run in parallel too. Terrain pairs run
 /// on one thread (the chunk cache is filled by queries); water voxels float bodies. Bodies that
 /// start inside solid are pushed out or refused (depenetration.h). Thread safety: one step()
 /// at a time; editGrid() and probeContacts() only between steps.
