@@ -49,12 +49,20 @@ Profiler::ThreadBuffer& Profiler::bufferForThisThread() {
 }
 
 void Profiler::record(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, bool serial) {
-  ThreadBuffer& b = bufferForThisThread();
-  if (b.frameStarts.empty() || b.frameStarts.back().first != frame_) {
-    if (!b.frameStarts.empty() && b.frameStarts.back().first > frame_) b.framesAscending = false;
-    b.frameStarts.push_back({frame_, b.events.size()});
+  append(bufferForThisThread(), {name, beginNs, endNs, 0, stage, frame_, serial});
+}
+
+void Profiler::recordInFrame(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, uint32_t frame) {
+  append(bufferForThisThread(), {name, beginNs, endNs, 0, stage, frame, false});
+}
+
+void Profiler::append(ThreadBuffer& b, ProfileEvent e) {
+  if (b.frameStarts.empty() || b.frameStarts.back().first != e.frame) {
+    if (!b.frameStarts.empty() && b.frameStarts.back().first > e.frame) b.framesAscending = false;
+    b.frameStarts.push_back({e.frame, b.events.size()});
   }
-  b.events.push_back({name, beginNs, endNs, b.thread, stage, frame_, serial});
+  e.thread = b.thread;
+  b.events.push_back(e);
 }
 
 std::vector<ProfileEvent> Profiler::events() const {

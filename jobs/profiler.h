@@ -72,6 +72,9 @@ class Profiler {
   }
   /// Appends a closed zone from the calling thread (serial: see WorkSpan).
   void record(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, bool serial = false);
+  /// The same for a thread that runs beside the frames (a render thread): the zone belongs to
+  /// `frame` as given, since frame() is the controlling thread's and not safe to read here.
+  void recordInFrame(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, uint32_t frame);
 
   /// All recorded events, sorted by (begin, thread, end).
   std::vector<ProfileEvent> events() const;
@@ -90,6 +93,7 @@ class Profiler {
  private:
   struct ThreadBuffer;
   ThreadBuffer& bufferForThisThread();
+  static void append(ThreadBuffer& b, ProfileEvent e);
 
   std::chrono::steady_clock::time_point epoch_;
   bool enabled_ = true;

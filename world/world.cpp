@@ -30,7 +30,7 @@ World::World(const SceneDescription& scene, int threads, SubmissionMode submissi
   resolveStartsInSolid();
   if (scene_.attachments.enabled)
     render_ = std::make_unique<WorldRender>(buildAttachments(), submission, bodies_.size(), scene_.attachments.batchPrimitives,
-                                            scene_.attachments.batchLights);
+                                            scene_.attachments.batchLights, profiler_);
 }
 
 const RenderScene& World::renderScene() {

@@ -80,8 +80,12 @@ class World {
   const StepStats& lastStats() const { return stats_; }
   /// The scene as validated and built.
   const SceneDescription& scene() const { return scene_; }
-  /// Profiling zones of the steps (Chrome trace, work/span).
-  Profiler& profiler() { return profiler_; }
+  /// Profiling zones of the steps (Chrome trace, work/span), the render thread's included: with
+  /// attachments it first waits until every frame was applied (the render thread records too).
+  Profiler& profiler() {
+    if (render_) render_->finish();
+    return profiler_;
+  }
   /// Bricks in all grids (a grid shared by several bodies counts once).
   uint64_t brickCount() const;
   /// Grids in the world, in scene order (spawned grid copies share their template's grid).

@@ -20,7 +20,7 @@ uint32_t batchSize(uint32_t asked, uint32_t all) { return asked == 0 ? all : ask
 }  // namespace
 
 WorldRender::WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bodyCount, uint32_t batchPrimitives,
-                         uint32_t batchLights)
+                         uint32_t batchLights, Profiler& profiler)
     : store_(std::move(store)),
       position_(bodyCount, Vec3d::Zero()),
       rotation_(bodyCount, Quatf::Identity()),
@@ -30,7 +30,17 @@ WorldRender::WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bo
   if (store_.bodiesReferenced() > bodyCount)
     throw InvalidInput("WorldRender: attachments ride on " + std::to_string(store_.bodiesReferenced()) + " bodies, the world has " +
                        std::to_string(bodyCount));
-  pipeline_ = std::make_unique<RenderFramePipeline>(store_, mode, RenderThread::FenceObserver{},
+  // At each fence, on the render thread: the busy time since the previous fence as one zone
+  // ending now, in the world's frame (pipeline frames count from 1, the world's from 0).
+  RenderThread::FenceObserver observer = [&profiler, lastBusy = uint64_t(0)](uint64_t frame, const RenderScene&,
+                                                                             const RenderThreadStats& stats) mutable {
+    if (profiler.enabled()) {
+      const int64_t end = profiler.now();
+      profiler.recordInFrame("render thread: apply", end - int64_t(stats.busyNanoseconds - lastBusy), end, -1, uint32_t(frame - 1));
+    }
+    lastBusy = stats.busyNanoseconds;
+  };
+  pipeline_ = std::make_unique<RenderFramePipeline>(store_, mode, std::move(observer),
                                                     batchSize(batchPrimitives, store_.primitiveCount()),
                                                     batchSize(batchLights, store_.lightCount()));
   // One timing slot per update chunk of every level, laid out once (the store no longer changes).

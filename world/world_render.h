@@ -65,7 +65,10 @@ class WorldRender {
  public:
   /// Render scene sized from store; a batch holds batchPrimitives / batchLights records a frame
   /// (0 = every primitive / light). bodyCount bodies are looked at.
-  WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bodyCount, uint32_t batchPrimitives, uint32_t batchLights);
+  /// The render thread records its busy time per frame into profiler (zone "render thread:
+  /// apply", stage -1: beside the frames, outside their work/span); read it after finish().
+  WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bodyCount, uint32_t batchPrimitives, uint32_t batchLights,
+              Profiler& profiler);
 
   /// Frame steps 5-7 for the bodies' current poses (see file comment).
   RenderStageStats run(const BodyStore& bodies, const SleepState& sleep, JobSystem& jobs, Profiler& profiler, int stage);

@@ -137,6 +137,44 @@ TEST(WorldRender, RenderSceneEqualsWorldPosesInEveryModeAndThreadCount) {
   }
 }
 
+TEST(WorldRender, ShippedSceneRenderSceneEqualsWorldPosesInEveryModeAndThreadCount) {
+  // truck_in_station: a kinematic ring station with its lights spinning, a dynamic truck with
+  // head and tail lights driving on its floor, crates in its bed; every kind of moving proxy.
+  SceneDescription desc = loadScene(std::string(BW_SCENES_DIR) + "/truck_in_station.json");
+  ASSERT_TRUE(desc.attachments.enabled);
+  constexpr uint32_t kFrames = 30;
+  uint64_t referenceScene = 0;
+  for (SubmissionMode mode : {SubmissionMode::Batched, SubmissionMode::PerObjectMutexNoRadius, SubmissionMode::PerObjectConcurrentNoRadius}) {
+    for (int threads : {1, 2, 4, 16}) {
+      SCOPED_TRACE(std::string(submissionModeName(mode)) + ", " + std::to_string(threads) + " threads");
+      World world(desc, threads, mode);
+      for (uint32_t f = 0; f < kFrames; ++f) world.step();
+      EXPECT_GT(world.lastStats().render.lights, 0u) << "the station's and the truck's lights move every frame";
+      expectSceneMatchesWorld(world);
+      const uint64_t sceneHash = world.renderScene().stateHash();
+      if (referenceScene == 0) referenceScene = sceneHash;
+      EXPECT_EQ(sceneHash, referenceScene);
+    }
+  }
+}
+
+TEST(WorldRender, TheRenderThreadsBusyTimeIsInTheProfile) {
+  World world(renderScene(), 2);
+  for (int f = 0; f < 5; ++f) world.step();
+  uint32_t zones = 0;
+  std::vector<uint8_t> frames(5, 0);
+  for (const ProfileEvent& e : world.profiler().events())
+    if (std::string(e.name) == "render thread: apply") {
+      ++zones;
+      ASSERT_LT(e.frame, 5u);
+      frames[e.frame] = 1;
+      EXPECT_EQ(e.stage, -1) << "beside the frames, not in their work/span";
+      EXPECT_LE(e.beginNs, e.endNs);
+    }
+  EXPECT_EQ(zones, 5u);
+  for (uint8_t seen : frames) EXPECT_EQ(seen, 1);
+}
+
 TEST(WorldRender, SleepingAndStaticBodiesSubmitNothing) {
   // Boxes dropped on a static floor: after they sleep, no record is submitted at all.
   const SceneDescription desc = parseScene(R"({
