@@ -1,6 +1,7 @@
 #include "world/broadphase.h"
 
 #include <algorithm>
+#include <optional>
 #include <string>
 
 #include "collision/core/argument_checks.h"
@@ -18,8 +19,23 @@ void SweepAndPrune::sortInBulk(const std::vector<WorldAabb>& bounds) {
   for (uint32_t i = 0; i < n; ++i) order_[i] = keys_[i].second;
 }
 
-void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic,
-                           std::vector<BodyPair>& pairs) {
+namespace {
+
+// A profiling zone when there is a profiler.
+struct MaybeZone {
+  std::optional<ProfileZone> zone;
+  MaybeZone(Profiler* profiler, const char* name, int stage) {
+    if (profiler) zone.emplace(*profiler, name, stage);
+  }
+};
+
+}  // namespace
+
+void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, std::vector<BodyPair>& pairs,
+                           JobSystem* jobs, Profiler* profiler, int stage) {
+  jobs_ = jobs;
+  profiler_ = profiler;
+  std::optional<MaybeZone> sortZone(std::in_place, profiler, "broadphase: sort", stage);
   const uint32_t n = uint32_t(bounds.size());
   if (isStatic.size() != bounds.size())
     throw InvalidInput("SweepAndPrune::update: " + std::to_string(bounds.size()) + " bounds but " +
@@ -73,26 +89,60 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
     }
     if (moves > budget) sortInBulk(bounds);
   }
+  sortZone.reset();
+  // The sorted copy, then the sweep: each body tests the bodies after it in the sorted order up
+  // to its own max. Bodies are independent, so both run in chunks; each chunk of the sweep
+  // writes its own pair list, and the lists are joined in chunk order and sorted: the same
+  // pairs for any thread count.
   const int a1 = (axis_ + 1) % 3, a2 = (axis_ + 2) % 3;
   sorted_.resize(n);
-  for (uint32_t i = 0; i < n; ++i) {
-    const WorldAabb& b = bounds[order_[i]];
-    sorted_[i] = {b.min[axis_], b.max[axis_], b.min[a1], b.max[a1], b.min[a2], b.max[a2], order_[i], isStatic[order_[i]]};
-  }
+  forChunks(n, stage + 1, "broadphase: sorted copy", [&](uint32_t begin, uint32_t end) {
+    for (uint32_t i = begin; i < end; ++i) {
+      const WorldAabb& b = bounds[order_[i]];
+      sorted_[i] = {b.min[axis_], b.max[axis_], b.min[a1], b.max[a1], b.min[a2], b.max[a2], order_[i], isStatic[order_[i]]};
+    }
+  });
+  const uint32_t chunks = JobSystem::chunkCount(0, n, kSweepGrain);
+  if (chunkPairs_.size() < chunks) chunkPairs_.resize(chunks);
+  chunkTests_.assign(chunks, 0);
+  forChunks(n, stage + 2, "broadphase: sweep", [&](uint32_t begin, uint32_t end) {
+    const uint32_t chunk = begin / kSweepGrain;
+    std::vector<BodyPair>& out = chunkPairs_[chunk];
+    out.clear();
+    uint64_t tests = 0;
+    for (uint32_t i = begin; i < end; ++i) {
+      const Sorted& a = sorted_[i];
+      for (uint32_t j = i + 1; j < n; ++j) {
+        const Sorted& b = sorted_[j];
+        ++tests;
+        if (b.lo > a.hi) break;  // sorted by min: nothing further can overlap
+        if (a.isStatic && b.isStatic) continue;
+        if (a.lo1 <= b.hi1 && b.lo1 <= a.hi1 && a.lo2 <= b.hi2 && b.lo2 <= a.hi2)
+          out.push_back(a.body < b.body ? BodyPair{a.body, b.body} : BodyPair{b.body, a.body});
+      }
+    }
+    chunkTests_[chunk] = tests;
+  });
+  const MaybeZone joinZone(profiler_, "broadphase: join pairs", stage + 3);
   pairs.clear();
   tests_ = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    const Sorted& a = sorted_[i];
-    for (uint32_t j = i + 1; j < n; ++j) {
-      const Sorted& b = sorted_[j];
-      ++tests_;
-      if (b.lo > a.hi) break;  // sorted by min: nothing further can overlap
-      if (a.isStatic && b.isStatic) continue;
-      if (a.lo1 <= b.hi1 && b.lo1 <= a.hi1 && a.lo2 <= b.hi2 && b.lo2 <= a.hi2)
-        pairs.push_back(a.body < b.body ? BodyPair{a.body, b.body} : BodyPair{b.body, a.body});
-    }
+  for (uint32_t c = 0; c < chunks; ++c) {
+    pairs.insert(pairs.end(), chunkPairs_[c].begin(), chunkPairs_[c].end());
+    tests_ += chunkTests_[c];
   }
   std::sort(pairs.begin(), pairs.end());
+}
+
+template <class F>
+void SweepAndPrune::forChunks(uint32_t n, int stage, const char* zone, F&& body) {
+  if (jobs_) {
+    jobs_->parallelFor(0, n, kSweepGrain, [&](uint32_t begin, uint32_t end) {
+      const MaybeZone z(profiler_, zone, stage);
+      body(begin, end);
+    });
+    return;
+  }
+  for (uint32_t begin = 0; begin < n; begin += kSweepGrain) body(begin, std::min(n, begin + kSweepGrain));
 }
 
 }  // namespace bw

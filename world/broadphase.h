@@ -10,12 +10,14 @@
 ///
 /// Determinism: the output is sorted by (a, b) with a < b, and does not depend on the previous
 /// order or on thread count.
-/// Thread safety: one thread; call update() between steps.
+/// Thread safety: one update() at a time (it may run its chunks on a JobSystem).
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 #include "collision/core/math_types.h"
+#include "jobs/job_system.h"
+#include "jobs/profiler.h"
 
 namespace bw {
 
@@ -41,12 +43,25 @@ class SweepAndPrune {
   /// Finds overlapping pairs among bodies (bounds[i] belongs to body i; isStatic[i] bodies never
   /// pair with each other). Replaces `pairs`. Throws InvalidInput for non-finite or inverted
   /// bounds, naming the body.
-  void update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, std::vector<BodyPair>& pairs);
+  /// With jobs, the sorted copy and the sweep run in chunks on it (the same pairs for any thread
+  /// count); with a profiler, zones at stage (sort, serial), stage + 1 (sorted copy), stage + 2
+  /// (sweep) and stage + 3 (pairs joined and sorted, serial).
+  void update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, std::vector<BodyPair>& pairs,
+              JobSystem* jobs = nullptr, Profiler* profiler = nullptr, int stage = -1);
   /// Interval comparisons made by the last update (machine-independent cost).
   uint64_t lastTests() const { return tests_; }
 
  private:
   void sortInBulk(const std::vector<WorldAabb>& bounds);
+  template <class F>
+  void forChunks(uint32_t n, int stage, const char* zone, F&& body);
+
+  /// Bodies per chunk of the sorted copy and the sweep.
+  static constexpr uint32_t kSweepGrain = 1024;
+  JobSystem* jobs_ = nullptr;      // of the running update
+  Profiler* profiler_ = nullptr;   // of the running update
+  std::vector<std::vector<BodyPair>> chunkPairs_;  // the sweep's pairs per chunk, reused
+  std::vector<uint64_t> chunkTests_;
 
   std::vector<uint32_t> order_;  // body ids sorted by min on axis_, kept between frames
   std::vector<std::pair<double, uint32_t>> keys_;  // sortInBulk scratch

@@ -7,6 +7,7 @@
 // A body the boxes miss has no brick within its bounds, so it would have had no contacts: the
 // contacts, and so the state, are the same as with one box per grid.
 #include <algorithm>
+#include <optional>
 
 #include "world/world.h"
 #include "world/world_tuning.h"
@@ -14,6 +15,7 @@
 namespace bw {
 
 void World::findPairs() {
+  std::optional<ProfileZone> proxies(std::in_place, profiler_, "broadphase: proxies", stage_ + 0);
   const uint32_t n = bodies_.size();
   proxyBounds_.clear();
   proxyStatic_.clear();
@@ -48,7 +50,9 @@ void World::findPairs() {
       proxyBody_.push_back(i);
     }
   }
-  broadphase_.update(proxyBounds_, proxyStatic_, proxyPairs_);
+  proxies.reset();
+  broadphase_.update(proxyBounds_, proxyStatic_, proxyPairs_, &jobs_, &profiler_, stage_ + 14);
+  ProfileZone dedupe(profiler_, "broadphase: pairs of bodies", stage_ + 18);
   pairs_.clear();
   for (const BodyPair& p : proxyPairs_) {
     const uint32_t a = proxyBody_[p.a], b = proxyBody_[p.b];

@@ -80,10 +80,7 @@ void World::substep(float dt, int index) {
   stage_ = stage;
   auto t = Clock::now();
   computeBounds(scene_.settings.gravity.cast<float>() * dt, stage + 6);
-  {
-    ProfileZone z(profiler_, "broadphase", stage + 0);
-    findPairs();
-  }
+  findPairs();
   stats_.broadphaseMs += msSince(t);
   t = Clock::now();
   {

@@ -185,11 +185,12 @@ class World {
   void applyGridEdits();
   /// A dynamic grid body's mass, centre of mass and inertia after its grid was edited.
   void refreshGridBodyMass(uint32_t body);
-  // Profiling stages per substep: broadphase (0), contacts (1), waking touched sleepers (2),
+  // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
   // solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first), sleeping's two
   // passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11: union,
-  // 12: flatten, 13: contacts grouped).
-  static constexpr int kStagesPerSubstep = 14;
+  // 12: flatten, 13: contacts grouped), the sweep and prune (14: sort, 15: sorted copy, 16:
+  // sweep, 17: pairs joined) and the proxies' pairs turned into body pairs (18).
+  static constexpr int kStagesPerSubstep = 19;
 
   SceneDescription scene_;
   JobSystem jobs_;
