@@ -35,7 +35,7 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
                            JobSystem* jobs, Profiler* profiler, int stage) {
   jobs_ = jobs;
   profiler_ = profiler;
-  std::optional<MaybeZone> sortZone(std::in_place, profiler, "broadphase: sort", stage);
+  MaybeZone sortZone(profiler, "broadphase: sort", stage);
   const uint32_t n = uint32_t(bounds.size());
   if (isStatic.size() != bounds.size())
     throw InvalidInput("SweepAndPrune::update: " + std::to_string(bounds.size()) + " bounds but " +
@@ -89,7 +89,7 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
     }
     if (moves > budget) sortInBulk(bounds);
   }
-  sortZone.reset();
+  sortZone.zone.reset();
   // The sorted copy, then the sweep: each body tests the bodies after it in the sorted order up
   // to its own max. Bodies are independent, so both run in chunks; each chunk of the sweep
   // writes its own pair list, and the lists are joined in chunk order and sorted: the same

@@ -23,6 +23,7 @@
 /// Overflow of a batch (deliberately small capacities): run() throws CapacityExceeded naming
 /// the batch and its capacity; the render scene keeps the previous frame, and every attachment
 /// is resent on the next frame so the render scene catches up at once.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -47,6 +48,21 @@ inline RenderStageKind renderStageKind(int offset) {
   if (offset == 0) return RenderStageKind::Poses;
   if (offset == kRenderCommitStage) return RenderStageKind::Commit;
   return offset % 2 == 1 ? RenderStageKind::Update : RenderStageKind::Submission;
+}
+
+/// A frame's render time predicted at `threads` from its work/span (`renderStage`: the stage id
+/// run() was given): per render stage max(work / threads, span), serial zones (mutex pushes)
+/// all in the span. Submission and commit, and the transform update too when withUpdate.
+inline double predictedRenderMs(const WorkSpan& frame, int renderStage, int threads, bool withUpdate = false) {
+  double total = 0;
+  for (size_t s = 0; s < frame.stageIds.size(); ++s) {
+    const int offset = frame.stageIds[s] - renderStage;
+    if (offset < 0 || offset > kRenderCommitStage) continue;
+    const RenderStageKind kind = renderStageKind(offset);
+    if (kind == RenderStageKind::Submission || kind == RenderStageKind::Commit || withUpdate)
+      total += std::max(frame.stageWorkMs[s] / threads, frame.stageSpanMs[s]);
+  }
+  return total;
 }
 
 /// The render part of one world frame (times in ms, wall clock on the game thread).

@@ -220,14 +220,7 @@ void WorldRenderFrame(benchmark::State& state, SubmissionMode mode, const char* 
     world.renderScene();
     // Submission + commit at 16 threads: per stage max(work / 16, span); the mutex queue's
     // pushes are serial zones, all in the span.
-    for (const WorkSpan& ws : world.profiler().workSpans(kFrames))
-      for (size_t k = 0; k < ws.stageIds.size(); ++k) {
-        const int offset = ws.stageIds[k] - world.renderStage();
-        if (offset < 0 || offset > kRenderCommitStage) continue;
-        const RenderStageKind kind = renderStageKind(offset);
-        if (kind == RenderStageKind::Submission || kind == RenderStageKind::Commit)
-          predicted16 += std::max(ws.stageWorkMs[k] / 16, ws.stageSpanMs[k]);
-      }
+    for (const WorkSpan& ws : world.profiler().workSpans(kFrames)) predicted16 += predictedRenderMs(ws, world.renderStage(), 16);
   }
   const double frames = double(kFrames) * double(state.iterations());
   renderFigures()[std::string(renderModeName(mode)) + "/" + scene] = {submitCommit / frames, predicted16 / frames};

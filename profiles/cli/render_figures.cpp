@@ -26,15 +26,7 @@ void RenderFigures::finish(World& world) {
 
 double RenderFigures::predictedMs(int threads, bool withUpdate) const {
   double total = 0;
-  for (const WorkSpan& ws : spans) {
-    for (size_t s = 0; s < ws.stageIds.size(); ++s) {
-      const int offset = ws.stageIds[s] - renderStage;
-      if (offset < 0 || offset > kRenderCommitStage) continue;
-      const RenderStageKind kind = renderStageKind(offset);
-      const bool counted = kind == RenderStageKind::Submission || kind == RenderStageKind::Commit || withUpdate;
-      if (counted) total += std::max(ws.stageWorkMs[s] / threads, ws.stageSpanMs[s]);
-    }
-  }
+  for (const WorkSpan& ws : spans) total += predictedRenderMs(ws, renderStage, threads, withUpdate);
   return spans.empty() ? 0 : total / double(spans.size());
 }
 

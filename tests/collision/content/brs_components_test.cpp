@@ -22,11 +22,6 @@ namespace {
 
 using namespace test::brsfile;
 
-const BrsLoadResult& lighthouse() {
-  static const BrsLoadResult r = loadBrs(lighthousePath().string());
-  return r;
-}
-
 // Lighthouse_Island's components section, uncompressed, found by walking the section headers
 // (magic, version, game version; header1, header2, the preview, bricks, components).
 std::vector<uint8_t> lighthouseComponentsSection() {

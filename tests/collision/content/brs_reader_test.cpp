@@ -24,12 +24,6 @@ namespace {
 
 using namespace test::brsfile;
 
-// Loaded once: the suite parses the 1.3 MB file many times already.
-const BrsLoadResult& lighthouse() {
-  static const BrsLoadResult r = loadBrs(lighthousePath().string());
-  return r;
-}
-
 class BrsLighthouse : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -33,6 +33,12 @@ inline std::filesystem::path lighthousePath() {
   return candidate;
 }
 
+// Lighthouse_Island loaded once per test binary: the suites parse the 1.3 MB file many times already.
+inline const BrsLoadResult& lighthouse() {
+  static const BrsLoadResult r = loadBrs(lighthousePath().string());
+  return r;
+}
+
 inline std::vector<uint8_t> readFile(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::vector<uint8_t>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

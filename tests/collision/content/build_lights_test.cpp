@@ -16,11 +16,6 @@
 namespace bw {
 namespace {
 
-Aabb worldBox(const Brick& b) {
-  const Vec3f h = b.rotation.applyToExtent(b.halfSize);
-  return {b.position - h, b.position + h};
-}
-
 bool sameLights(const std::vector<BuildLight>& a, const std::vector<BuildLight>& b) {
   if (a.size() != b.size()) return false;
   for (size_t i = 0; i < a.size(); ++i)
@@ -51,7 +46,7 @@ TEST(BuildLights, InsideTheBoundsAndNeverInsideABrick) {
       const Aabb grown = g.bounds.expanded(0.5f);
       std::vector<Aabb> boxes;
       boxes.reserve(g.bricks.size());
-      for (const Brick& b : g.bricks) boxes.push_back(worldBox(b).expanded(0.05f));
+      for (const Brick& b : g.bricks) boxes.push_back(brickBounds(b).expanded(0.05f));
       size_t outside = 0, inBrick = 0;
       for (size_t i = 0; i < g.lights.size(); ++i) {
         const BuildLight& l = g.lights[i];
