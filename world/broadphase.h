@@ -1,22 +1,27 @@
 #pragma once
 /// Body-level broadphase: which bodies' world bounds overlap.
 ///
-/// Choice: sweep and prune on the axis of largest spread, with the sorted order kept from
-/// frame to frame (insertion sort is near-linear when bodies move a little per step); the
-/// first frame, and any frame whose insertion sort would exceed ~8 moves per body, sorts in
-/// bulk instead (O(n log n): no quadratic first frame). Bodies
-/// are few (thousands) next to the bricks inside grids, which never pay a per-frame index
-/// update here: a grid is one box in this list. Pairs of two static bodies are skipped.
+/// Choice (bench_world Broadphase/* at 1k-1M bodies, against Bullet's btDbvtBroadphase and
+/// btAxisSweep3): moving proxies (dynamic and kinematic) in a sweep and prune on the axis of
+/// largest spread, the sorted order kept from frame to frame (insertion sort is near-linear
+/// when bodies move a little per step; the first frame, a changed set of moving proxies, or a
+/// frame whose insertion sort would exceed ~8 moves per body sorts in bulk, in parallel: no
+/// quadratic first frame). Static proxies never enter the sweep: they sit in a tree built in
+/// bulk (StaticBoundsTree), rebuilt only when a static box changes, and every moving proxy
+/// queries it. New pairs are found per moving proxy in parallel chunks, each chunk writing its
+/// own list; the lists are joined in chunk order and sorted in parallel.
 ///
-/// Determinism: the output is sorted by (a, b) with a < b, and does not depend on the previous
-/// order or on thread count.
-/// Thread safety: one update() at a time (it may run its chunks on a JobSystem).
+/// Determinism: the output is sorted by (a, b) with a < b, without repeats, and does not depend
+/// on the previous order or on thread count.
+/// Thread safety: one update() at a time (it runs its chunks on a JobSystem when given one).
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "collision/core/math_types.h"
 #include "jobs/job_system.h"
+#include "jobs/parallel_sort.h"
 #include "jobs/profiler.h"
 
 namespace bw {
@@ -38,44 +43,79 @@ struct BodyPair {
   bool operator==(const BodyPair& o) const = default;
 };
 
+class StaticBoundsTree;
+
 class SweepAndPrune {
  public:
-  /// Finds overlapping pairs among bodies (bounds[i] belongs to body i; isStatic[i] bodies never
-  /// pair with each other). Replaces `pairs`. Throws InvalidInput for non-finite or inverted
-  /// bounds, naming the body.
-  /// With jobs, the sorted copy and the sweep run in chunks on it (the same pairs for any thread
-  /// count); with a profiler, zones at stage (sort, serial), stage + 1 (sorted copy), stage + 2
-  /// (sweep) and stage + 3 (pairs joined and sorted, serial).
+  /// Profiler stages update() uses, from its `stage` argument on.
+  static constexpr int kStages = 13;
+
+  SweepAndPrune();
+  ~SweepAndPrune();
+  SweepAndPrune(SweepAndPrune&&) noexcept;
+  SweepAndPrune& operator=(SweepAndPrune&&) noexcept;
+
+  /// Finds overlapping pairs among proxies (bounds[i] belongs to proxy i; isStatic[i] proxies
+  /// never pair with each other). Replaces `pairs`. With `owner` (one entry per proxy), the
+  /// pairs are of owners: (owner[i], owner[j]) for overlapping proxies i and j of different
+  /// owners, each pair once. Throws InvalidInput for non-finite or inverted bounds, naming the
+  /// proxy, or mismatched lengths.
+  /// With jobs, the stages run in chunks on it (the same pairs for any thread count); with a
+  /// profiler, zones at stage (order, serial), stage + 1..4 (bulk sort, when it runs),
+  /// stage + 5 (sorted copy), stage + 6 (sweep costs), stage + 7 (sweep and static queries),
+  /// stage + 8 (join) and stage + 9..12 (pairs sorted).
   void update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, std::vector<BodyPair>& pairs,
-              JobSystem* jobs = nullptr, Profiler* profiler = nullptr, int stage = -1);
-  /// Interval comparisons made by the last update (machine-independent cost).
+              JobSystem* jobs = nullptr, Profiler* profiler = nullptr, int stage = -1,
+              const std::vector<uint32_t>* owner = nullptr);
+  /// Interval and box comparisons made by the last update (machine-independent cost).
   uint64_t lastTests() const { return tests_; }
+  /// Times the static tree was built (first update, and after static boxes changed).
+  uint64_t staticBuilds() const { return staticBuilds_; }
 
  private:
-  void sortInBulk(const std::vector<WorldAabb>& bounds);
+  void validate(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner) const;
+  bool staticSetChanged(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic);
+  bool insertionSort(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic);
+  void sortInBulk(const std::vector<WorldAabb>& bounds, int stage);
   template <class F>
-  void forChunks(uint32_t n, int stage, const char* zone, F&& body);
+  void forChunks(uint32_t n, uint32_t grain, int stage, const char* zone, F&& body);
+  void sortPairs(std::vector<BodyPair>& pairs, int stage);
 
-  /// Bodies per chunk of the sorted copy and the sweep.
-  static constexpr uint32_t kSweepGrain = 1024;
+  /// Fewest moving proxies per chunk of the sorted copy and the sweep costs.
+  static constexpr uint32_t kMinSweepGrain = 128;
+  /// The sweep's cost model, in interval tests: a job gets at least kMinSweepJobCost (a test is
+  /// about a nanosecond, a job's scheduling about a microsecond).
+  static constexpr uint64_t kMinSweepJobCost = 1024;
   JobSystem* jobs_ = nullptr;      // of the running update
   Profiler* profiler_ = nullptr;   // of the running update
   std::vector<std::vector<BodyPair>> chunkPairs_;  // the sweep's pairs per chunk, reused
-  std::vector<uint64_t> chunkTests_;
+  std::vector<uint64_t> chunkTests_, chunkTreeTests_;
+  uint64_t queryTestsPerProxy_ = 8;  // static tree box tests per moving proxy, last update
+  std::vector<uint32_t> chunkOffset_;
+  std::vector<uint64_t> costPrefix_, chunkCost_;  // sweep costs: per proxy (prefix within its chunk), per chunk
+  std::vector<uint32_t> jobBegin_;                // first sorted proxy of each sweep job
 
-  std::vector<uint32_t> order_;  // body ids sorted by min on axis_, kept between frames
-  std::vector<std::pair<double, uint32_t>> keys_;  // sortInBulk scratch
+  std::vector<uint32_t> moving_;  // moving proxy ids, ascending (scratch)
+  std::vector<uint32_t> order_;   // moving proxy ids sorted by (min on axis_, id), kept between frames
+  std::vector<std::pair<double, uint32_t>> keys_;  // bulk sort: (min on the axis, id)
+  ParallelSorter<std::pair<double, uint32_t>> keySorter_;
+  ParallelSorter<BodyPair> pairSorter_;
   // The bounds in that order, copied each update: the sweep then reads memory in order instead
   // of jumping through order_ (the pile of a landing rain overlaps dozens of bodies per body).
   struct Sorted {
     double lo, hi;                // on axis_
     double lo1, hi1, lo2, hi2;    // on the two other axes
-    uint32_t body;
-    uint8_t isStatic;
+    uint32_t proxy;
   };
   std::vector<Sorted> sorted_;
   int axis_ = 0;
   uint64_t tests_ = 0;
+
+  // The static proxies the tree was built over (ids and boxes), to see when they change.
+  std::vector<uint32_t> staticIds_, staticScratch_;
+  std::vector<WorldAabb> staticBoxes_;
+  std::unique_ptr<StaticBoundsTree> staticTree_;
+  uint64_t staticBuilds_ = 0;
 };
 
 }  // namespace bw

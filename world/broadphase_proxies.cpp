@@ -3,7 +3,8 @@
 // tuning::kCoverBoxes). A body falling
 // onto a city is then paired with it only near a building or a street, not for its whole fall
 // through the city's bounding box (each such pair cost a grid query that met nothing). Pairs
-// found through several of a grid's boxes are one pair; the pairs come out sorted as before.
+// found through several of a grid's boxes are one pair (the broadphase reports pairs of the
+// proxies' owners); the pairs come out sorted as before.
 // A body the boxes miss has no brick within its bounds, so it would have had no contacts: the
 // contacts, and so the state, are the same as with one box per grid.
 #include <algorithm>
@@ -51,15 +52,8 @@ void World::findPairs() {
     }
   }
   proxies.reset();
-  broadphase_.update(proxyBounds_, proxyStatic_, proxyPairs_, &jobs_, &profiler_, stage_ + 14);
-  ProfileZone dedupe(profiler_, "broadphase: pairs of bodies", stage_ + 18);
-  pairs_.clear();
-  for (const BodyPair& p : proxyPairs_) {
-    const uint32_t a = proxyBody_[p.a], b = proxyBody_[p.b];
-    if (a != b) pairs_.push_back(a < b ? BodyPair{a, b} : BodyPair{b, a});
-  }
-  std::sort(pairs_.begin(), pairs_.end());
-  pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+  // Proxies of one grid pair with a body once: the broadphase's pairs are of owners.
+  broadphase_.update(proxyBounds_, proxyStatic_, pairs_, &jobs_, &profiler_, stage_ + 14, &proxyBody_);
 }
 
 }  // namespace bw

@@ -66,7 +66,7 @@ void World::computeBounds(const Vec3f& gravityDt, int stage) {
   // Per body: gravity on an awake dynamic body (semi-implicit Euler: before everything that
   // reads the velocity), then its bounds. Each body writes only its own slots: parallel, and
   // the same for any thread count.
-  jobs_.parallelFor(0, n, tuning::kBodyGrain, [&](uint32_t begin, uint32_t end) {
+  jobs_.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "gravity and bounds", stage);
     for (uint32_t i = begin; i < end; ++i) {
       if (bodies_.motion[i] == MotionType::Dynamic && !sleep_.asleep(i)) bodies_.linearVelocity[i] += gravityDt;

@@ -114,7 +114,7 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
                             const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler, int stage) {
   const uint32_t n = bodies.size();
   inverseInertiaWorld_.resize(n);
-  jobs.parallelFor(0, n, tuning::kBodyGrain, [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "prepare: inertia", stage);
     for (uint32_t i = begin; i < end; ++i) inverseInertiaWorld_[i] = bodies.inverseInertiaWorld(i);
   });
@@ -125,7 +125,7 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
   first_[0] = 0;
   for (uint32_t k = 0; k < pairCount; ++k) first_[k + 1] = first_[k] + uint32_t(pairContacts[k].size());
   contacts_.resize(first_[pairCount]);
-  jobs.parallelFor(0, pairCount, kPrepareGrain, [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, pairCount, tuning::grainFor(pairCount, kMinPrepareGrain), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "prepare: contacts", stage + 1);
     for (uint32_t k = begin; k < end; ++k) {
       // Solver convention: the normal points from b towards a.

@@ -52,8 +52,9 @@ class ContactSolver {
                    JobSystem& jobs, Profiler& profiler, int stage);
 
  private:
-  /// Pairs per job of prepare(): a contact costs ~100 ns, a pair up to manifoldSize of them.
-  static constexpr uint32_t kPrepareGrain = 256;
+  /// Fewest pairs per job of prepare(): a contact costs ~100 ns, a pair up to manifoldSize of
+  /// them, so 32 pairs are several microseconds.
+  static constexpr uint32_t kMinPrepareGrain = 32;
   SolverContact makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c,
                             const SceneSettings& settings, float dt) const;
   void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);

@@ -38,7 +38,7 @@ void Islands::build(const std::vector<SolverContact>& contacts, const std::vecto
   // the smaller (compare-and-swap on the larger, which must still be a root), so every island's
   // root is its smallest body id whatever the order the links were made in: the grouping is a
   // pure function of the contact list, for any thread count.
-  jobs.parallelFor(0, uint32_t(contacts.size()), tuning::kIslandGrain, [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, uint32_t(contacts.size()), tuning::grainFor(uint32_t(contacts.size()), tuning::kMinIslandGrain), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "islands: union", stage);
     for (uint32_t k = begin; k < end; ++k) {
       const SolverContact& c = contacts[k];
@@ -53,7 +53,7 @@ void Islands::build(const std::vector<SolverContact>& contacts, const std::vecto
     }
   });
   // Every body points straight at its root (after the join, so no link is still being made).
-  jobs.parallelFor(0, n, tuning::kBodyGrain, [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "islands: flatten", stage + 1);
     for (uint32_t i = begin; i < end; ++i) std::atomic_ref<uint32_t>(parent_[i]).store(findConcurrent(parent_, i), std::memory_order_relaxed);
   });

@@ -188,9 +188,8 @@ class World {
   // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
   // solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first), sleeping's two
   // passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11: union,
-  // 12: flatten, 13: contacts grouped), the sweep and prune (14: sort, 15: sorted copy, 16:
-  // sweep, 17: pairs joined) and the proxies' pairs turned into body pairs (18).
-  static constexpr int kStagesPerSubstep = 19;
+  // 12: flatten, 13: contacts grouped), the sweep and prune (14 .. 14 + SweepAndPrune::kStages - 1).
+  static constexpr int kStagesPerSubstep = 14 + SweepAndPrune::kStages;
 
   SceneDescription scene_;
   JobSystem jobs_;
@@ -223,7 +222,6 @@ class World {
   std::vector<WorldAabb> proxyBounds_;
   std::vector<uint8_t> proxyStatic_;
   std::vector<uint32_t> proxyBody_;
-  std::vector<BodyPair> proxyPairs_;
   std::vector<Aabb> coverScratch_;
   std::vector<BodyPair> pairs_;
   std::vector<std::vector<Contact>> pairContacts_;  // one slot per pair, reused across frames

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "collision/core/argument_checks.h"
+#include "world/world_tuning.h"
 
 namespace bw {
 
@@ -12,8 +13,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-// Bodies per chunk of the pose pass (a pose is ~60 flops: large chunks amortise scheduling).
-constexpr uint32_t kPoseGrain = 2048;
+// Fewest bodies per job of the pose pass (a pose is ~60 flops and a compare).
+constexpr uint32_t kMinPoseGrain = 256;
+// Fewest attachments per job of the transform update (an attachment is tens of nanoseconds).
+constexpr uint32_t kMinUpdateGrain = 128;
 
 uint32_t batchSize(uint32_t asked, uint32_t all) { return asked == 0 ? all : asked; }
 
@@ -26,7 +29,8 @@ WorldRender::WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bo
       rotation_(bodyCount, Quatf::Identity()),
       moved_(bodyCount, 0),
       asleepBefore_(bodyCount, 0),
-      movedPerChunk_(JobSystem::chunkCount(0, bodyCount, kPoseGrain), 0) {
+      poseGrain_(tuning::grainFor(bodyCount, kMinPoseGrain)),
+      movedPerChunk_(JobSystem::chunkCount(0, bodyCount, poseGrain_), 0) {
   if (store_.bodiesReferenced() > bodyCount)
     throw InvalidInput("WorldRender: attachments ride on " + std::to_string(store_.bodiesReferenced()) + " bodies, the world has " +
                        std::to_string(bodyCount));
@@ -47,8 +51,10 @@ WorldRender::WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bo
   store_.prepareUpdateOrder();
   uint32_t chunks = 0;
   for (uint32_t level = 0; level < store_.levelCount(); ++level) {
+    const uint32_t begin = store_.levelBegin(level), end = store_.levelBegin(level + 1);
     levelFirstChunk_.push_back(chunks);
-    chunks += JobSystem::chunkCount(store_.levelBegin(level), store_.levelBegin(level + 1), TransformUpdate::kDefaultGrain);
+    levelGrain_.push_back(tuning::grainFor(end - begin, kMinUpdateGrain));
+    chunks += JobSystem::chunkCount(begin, end, levelGrain_.back());
   }
   chunkTimes_.resize(chunks);
 }
@@ -57,7 +63,7 @@ uint32_t WorldRender::markMovedBodies(const BodyStore& bodies, const SleepState&
                                       int stage) {
   const uint32_t n = uint32_t(position_.size());
   const bool all = checkAll_;
-  jobs.parallelFor(0, n, kPoseGrain, [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, poseGrain_, [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "render poses", stage);
     uint32_t moved = 0;
     for (uint32_t i = begin; i < end; ++i) {
@@ -79,7 +85,7 @@ uint32_t WorldRender::markMovedBodies(const BodyStore& bodies, const SleepState&
       moved_[i] = 1;
       ++moved;
     }
-    movedPerChunk_[begin / kPoseGrain] = moved;
+    movedPerChunk_[begin / poseGrain_] = moved;
   });
   checkAll_ = false;
   uint32_t total = 0;
@@ -107,8 +113,9 @@ RenderStageStats WorldRender::run(const BodyStore& bodies, const SleepState& sle
       const uint32_t first = update.levelBegin(level);
       const uint32_t chunk0 = levelFirstChunk_[level];
       const int32_t updateStage = stage + 1 + 2 * int32_t(level);
-      jobs.parallelFor(first, update.levelEnd(level), TransformUpdate::kDefaultGrain, [&](uint32_t b, uint32_t e) {
-        UpdateRangeTimes& t = chunkTimes_[chunk0 + (b - first) / TransformUpdate::kDefaultGrain];
+      const uint32_t grain = levelGrain_[level];
+      jobs.parallelFor(first, update.levelEnd(level), grain, [&](uint32_t b, uint32_t e) {
+        UpdateRangeTimes& t = chunkTimes_[chunk0 + (b - first) / grain];
         const int64_t zoneStart = profiler.enabled() ? profiler.now() : 0;
         update.runRangeTimed(b, e, t);
         if (profiler.enabled()) {

@@ -113,9 +113,11 @@ class WorldRender {
   std::vector<Quatf> rotation_;
   std::vector<uint8_t> moved_;
   std::vector<uint8_t> asleepBefore_;         // asleep at the previous pose pass
+  uint32_t poseGrain_;                        // bodies per job of the pose pass
   std::vector<uint32_t> movedPerChunk_;       // pose pass: moved bodies per chunk
   std::vector<UpdateRangeTimes> chunkTimes_;  // transform update: per chunk of every level
   std::vector<uint32_t> levelFirstChunk_;     // index of each level's first chunk in chunkTimes_
+  std::vector<uint32_t> levelGrain_;          // attachments per job of each level
   bool checkAll_ = true;
   uint64_t reportedBusyNs_ = 0;
 };
