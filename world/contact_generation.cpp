@@ -2,6 +2,7 @@
 // (primitive vs grid through the grid's query, grid vs grid through the smaller grid's convex
 // approximation, primitive pairs directly), each pair writing its own slot, with speculative
 // margins and the pair cache. Pairs with a terrain are made afterwards (terrain_pairs.cpp).
+#include <optional>
 #include <string>
 
 #include "collision/core/errors.h"
@@ -89,6 +90,7 @@ void World::generateContacts(float dt) {
   base.maxContacts = scene_.settings.manifoldSize;
   // Convex approximations are cached per grid and refreshed lazily: warm them serially so the
   // parallel stage only reads them (copies of one crate grid share one cache).
+  std::optional<ProfileZone> warm(std::in_place, profiler_, "contacts: warm hulls", stage_ + kContactStepsStage);
   for (const BodyPair& p : pairs_) {
     const BodyShape& sa = bodies_.shape[p.a];
     const BodyShape& sb = bodies_.shape[p.b];
@@ -99,7 +101,8 @@ void World::generateContacts(float dt) {
     }
   }
   // Pair cache: a pair whose relative pose has barely moved reuses its last contacts.
-  pairCache_.match(pairs_);
+  warm.reset();
+  pairCache_.match(pairs_, jobs_, profiler_, stage_ + kContactStepsStage + 1);
   pairReused_.assign(n, 0);
   // Each pair writes only its own slot: the result does not depend on the thread count.
   jobs_.parallelFor(0, n, tuning::kPairGrain, [&](uint32_t begin, uint32_t end) {

@@ -152,20 +152,27 @@ void ContactSolver::applyImpulse(const SolverContact& s, int d, const Vec3f& dir
   }
 }
 
-void ContactSolver::loadBodies(const BodyStore& bodies) {
+void ContactSolver::loadBodies(const BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage) {
   const uint32_t n = bodies.size();
   bodies_.resize(n);
-  for (uint32_t i = 0; i < n; ++i)
-    bodies_[i] = {bodies.linearVelocity[i], bodies.inverseMass[i], bodies.angularVelocity[i],
-                  bodies.motion[i] == MotionType::Dynamic ? 1u : 0u};
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "solver: load bodies", stage);
+    for (uint32_t i = begin; i < end; ++i)
+      bodies_[i] = {bodies.linearVelocity[i], bodies.inverseMass[i], bodies.angularVelocity[i],
+                    bodies.motion[i] == MotionType::Dynamic ? 1u : 0u};
+  });
 }
 
-void ContactSolver::storeBodies(BodyStore& bodies) const {
-  for (uint32_t i = 0; i < bodies.size(); ++i) {
-    if (!bodies_[i].dynamic) continue;
-    bodies.linearVelocity[i] = bodies_[i].v;
-    bodies.angularVelocity[i] = bodies_[i].w;
-  }
+void ContactSolver::storeBodies(BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage) const {
+  const uint32_t n = bodies.size();
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "solver: store bodies", stage);
+    for (uint32_t i = begin; i < end; ++i) {
+      if (!bodies_[i].dynamic) continue;
+      bodies.linearVelocity[i] = bodies_[i].v;
+      bodies.angularVelocity[i] = bodies_[i].w;
+    }
+  });
 }
 
 void ContactSolver::warmStart(const SolverContact& s) {

@@ -7,7 +7,7 @@
 ///
 ///   solver.prepare(bodies, pairs, pairContacts, flipped, settings, dt, jobs, profiler, stage);
 ///   islands.build(solver.contacts(), bodies.motion);
-///   solver.loadBodies(bodies); solver.solve(islands, false, ...); solver.storeBodies(bodies);
+///   solver.loadBodies(bodies, jobs, prof); solver.solve(islands, false, ...); solver.storeBodies(bodies, jobs, prof);
 #include <cstdint>
 #include <vector>
 
@@ -41,8 +41,10 @@ class ContactSolver {
   const std::vector<SolverContact>& contacts() const { return contacts_; }
 
   /// Copies the bodies' velocities into the solver's compact records, and back (dynamic only).
-  void loadBodies(const BodyStore& bodies);
-  void storeBodies(BodyStore& bodies) const;
+  /// Copies the bodies' velocities in (and the solved ones back out), in parallel chunks with
+  /// zones at `stage`.
+  void loadBodies(const BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage = -1);
+  void storeBodies(BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage = -1) const;
 
   /// Warm start (not when relaxing) and iterate every island: islands above kSplitContacts
   /// first, one at a time, colour by colour on every thread; then the others whole, in

@@ -86,7 +86,15 @@ const ContainmentReport& ContainmentTracker::update() {
   for (uint32_t i = 0; i < bodies.size(); ++i) {
     if (bodies.motion[i] != MotionType::Dynamic) continue;
     const Vec3d& p = bodies.position[i];
-    if (p != lastSeen_[i]) {
+    if (p != lastSeen_[i] && state_[i] == InsideSolid::No && !world_.nearSolidLastStep(i)) {
+      // Clear before, and nowhere near a grid or terrain on its whole way here: clear now.
+      lastSeen_[i] = lastClear_[i] = p;
+      hasClear_[i] = 1;
+    } else if (p != lastSeen_[i] && state_[i] == InsideSolid::No && hasClear_[i] &&
+               (p - lastSeen_[i]).squaredNorm() < kRecheckDistance * kRecheckDistance) {
+      // Clear, and within kRecheckDistance of where it was last checked (a resting body): the
+      // next check, once it has moved further, tests the whole way from lastClear_.
+    } else if (p != lastSeen_[i]) {
       lastSeen_[i] = p;
       InsideSolid s = world_.pointInsideSolid(p, i);
       if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsStatic(lastClear_[i], p)) s = InsideSolid::WentThrough;

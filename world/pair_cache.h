@@ -7,6 +7,8 @@
 
 #include "collision/bricks/contact.h"
 #include "collision/core/rigid_transform.h"
+#include "jobs/job_system.h"
+#include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/broadphase.h"
 
@@ -14,9 +16,9 @@ namespace bw {
 
 class PairCache {
  public:
-  /// Matches this substep's pairs (sorted, as the broadphase makes them) with the entries made
-  /// last time: hit(k) is then pair k's entry, or -1.
-  void match(const std::vector<BodyPair>& pairs);
+  /// Matches this substep's pairs with the entries made last time (a binary search per pair,
+  /// in parallel chunks, zones at `stage`): hit(k) is then pair k's entry, or -1.
+  void match(const std::vector<BodyPair>& pairs, JobSystem& jobs, Profiler& profiler, int stage);
   int32_t hit(uint32_t k) const { return hits_[k]; }
 
   /// If pair k has an entry and the relative pose of its bodies (poses of a and b) moved less
@@ -27,8 +29,11 @@ class PairCache {
 
   /// Keeps every pair's contacts for the next substep. reused[k]: pair k's contacts came from
   /// reuse(), so its entry keeps its original relative pose (slow creep is caught once it adds up).
+  /// In parallel chunks: each chunk counts its entries and contacts (zones at `stage`), then
+  /// writes them at its offsets (stage + 1): the same entries in pair order for any thread count.
   void update(const std::vector<BodyPair>& pairs, const std::vector<std::vector<Contact>>& contacts,
-              const std::vector<uint8_t>& flipped, const std::vector<uint8_t>& reused, const BodyStore& bodies);
+              const std::vector<uint8_t>& flipped, const std::vector<uint8_t>& reused, const BodyStore& bodies, JobSystem& jobs,
+              Profiler& profiler, int stage);
 
   /// Forgets the entries of pairs for which pred(pair) holds (their contacts may be stale).
   template <class Pred>
@@ -51,6 +56,7 @@ class PairCache {
   std::vector<Entry> entries_, nextEntries_;
   std::vector<CachedContact> contacts_, nextContacts_;
   std::vector<int32_t> hits_;  // per pair of this substep: index into entries_ or -1
+  std::vector<uint32_t> chunkEntries_, chunkContacts_;  // update(): per chunk counts, then offsets
 };
 
 }  // namespace bw

@@ -87,7 +87,7 @@ void World::substep(float dt, int index) {
     ProfileZone z(profiler_, "contacts (stage)");
     generateContacts(dt);
     terrainPairs(dt);
-    pairCache_.update(pairs_, pairContacts_, pairFlipped_, pairReused_, bodies_);
+    pairCache_.update(pairs_, pairContacts_, pairFlipped_, pairReused_, bodies_, jobs_, profiler_, stage + kContactStepsStage + 2);
   }
   stats_.contactsMs += msSince(t);
   t = Clock::now();
@@ -104,11 +104,11 @@ void World::substep(float dt, int index) {
       islands_.groupContacts(solver_.contacts(), bodies_.motion);
     }
     ProfileZone z(profiler_, "solve (stage)");
-    solver_.loadBodies(bodies_);
+    solver_.loadBodies(bodies_, jobs_, profiler_, stage + kContactStepsStage + 4);
     const SolveStats solved = solver_.solve(islands_, bodies_.motion, false, scene_.settings, jobs_, profiler_, stage);
     stats_.largestIsland = solved.largestIsland;
     stats_.splitIslands += solved.splitIslands;
-    solver_.storeBodies(bodies_);
+    solver_.storeBodies(bodies_, jobs_, profiler_, stage + kContactStepsStage + 5);
   }
   stats_.solverMs += msSince(t);
   t = Clock::now();
@@ -120,13 +120,17 @@ void World::substep(float dt, int index) {
     // bodies carry into the next substep.
     ProfileZone z(profiler_, "relax (stage)");
     solver_.solve(islands_, bodies_.motion, true, scene_.settings, jobs_, profiler_, stage);
-    solver_.storeBodies(bodies_);
+    solver_.storeBodies(bodies_, jobs_, profiler_, stage + kContactStepsStage + 6);
   }
   stats_.solverMs += msSince(t);
   if (scene_.settings.sleeping) sleep_.update(bodies_, islands_, dt, jobs_, profiler_, stage + 7);
+  ProfileZone counters(profiler_, "counters", stage + kContactStepsStage + 7);
   stats_.pairs += uint32_t(pairs_.size());
   stats_.contacts += uint32_t(solver_.contacts().size());
   for (uint32_t k = 0; k < pairs_.size(); ++k) {
+    const BodyPair& p = pairs_[k];
+    if (isSolid(p.a)) nearSolid_[p.b] = 1;
+    if (isSolid(p.b)) nearSolid_[p.a] = 1;
     if (pairReused_[k]) {
       ++stats_.pairsReused;
       continue;
@@ -178,6 +182,7 @@ void World::refreshGridBodyMass(uint32_t body) {
 void World::step() {
   const auto t = Clock::now();
   stats_ = StepStats{};
+  nearSolid_.assign(bodies_.size(), 0);
   applyGridEdits();
   advanceDepenetration();
   profiler_.beginFrame(frame_);

@@ -27,6 +27,7 @@
 #include "collision/bricks/brick_grid.h"
 #include "collision/content/build_light.h"
 #include "collision/terrain/terrain.h"
+#include "collision/terrain/terrain_contacts.h"
 #include "jobs/job_system.h"
 #include "jobs/profiler.h"
 #include "world/body_store.h"
@@ -127,6 +128,10 @@ class World {
   /// Whether the segment from `from` to `to` (world) crosses a static or kinematic grid or a
   /// terrain. Fills terrain chunk caches as rays do, so not while step() runs.
   bool segmentHitsStatic(const Vec3d& from, const Vec3d& to);
+  /// Whether body `body` was paired by the broadphase with a grid or terrain body (other than
+  /// itself) in any substep of the last step. A body that was not cannot be inside solid nor
+  /// have crossed a surface during that step: every substep's bounds cover its motion in it.
+  bool nearSolidLastStep(uint32_t body) const { return nearSolid_[body] != 0; }
   /// The scene's ray load of the last frame: its rays and their closest hits (empty without one).
   const RayLoad& rayLoad() const { return rayLoad_; }
   /// Body `body`'s broadphase box in its current state (its shape's bounds plus a margin of how
@@ -174,6 +179,8 @@ class World {
   void generateContacts(float dt);
   void terrainPairs(float dt);
   bool canCollide(uint32_t a, uint32_t b) const;
+  /// A grid or terrain body (what another body can be inside of).
+  bool isSolid(uint32_t body) const { return bodies_.shape[body].isGrid() || bodies_.shape[body].isTerrain(); }
   /// The fastest the pair's surfaces can approach (m/s): relative speed plus both spins times radii.
   float closingSpeed(uint32_t a, uint32_t b) const;
   bool active(uint32_t body) const {
@@ -188,8 +195,15 @@ class World {
   // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
   // solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first), sleeping's two
   // passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11: union,
-  // 12: flatten, 13: contacts grouped), the sweep and prune (14 .. 14 + SweepAndPrune::kStages - 1).
-  static constexpr int kStagesPerSubstep = 14 + SweepAndPrune::kStages;
+  // 12: flatten, 13: contacts grouped), the sweep and prune (kBroadphaseStage, its kStages),
+  // terrain pairs (kTerrainStage: warm, query, apply), the pair cache and the other steps
+  // between (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded,
+  // stored after the solve and after the relax, counters).
+  // Every piece of a substep's work is in one of them: work/span sees the whole step.
+  static constexpr int kBroadphaseStage = 14;
+  static constexpr int kTerrainStage = kBroadphaseStage + SweepAndPrune::kStages;
+  static constexpr int kContactStepsStage = kTerrainStage + 3;
+  static constexpr int kStagesPerSubstep = kContactStepsStage + 8;
 
   SceneDescription scene_;
   JobSystem jobs_;
@@ -202,6 +216,7 @@ class World {
   std::vector<std::unique_ptr<Terrain>> terrains_;
   std::vector<float> waterDensity_;
   BodyStore bodies_;
+  std::vector<uint8_t> nearSolid_;     // per body: paired with a grid or terrain in this step (containment's filter)
   std::vector<uint32_t> solidBodies_;  // grid and terrain bodies, ascending (what bodies can be inside)
   std::vector<Depenetration> depenetrating_;
   std::vector<uint8_t> ghost_;  // per body: on its way out of solid (collides with nothing)
@@ -229,6 +244,17 @@ class World {
   std::vector<uint8_t> pairFlipped_;                // slot's contacts have normal from pair.a to pair.b
   std::vector<uint8_t> pairReused_;                 // slot's contacts came from the pair cache
   std::vector<ContactStats> pairStats_;
+  // One per pair with a terrain this substep (terrain_pairs.cpp).
+  struct TerrainQuery {
+    uint32_t pair, body, terrain;
+    RigidTransform pose;  // the body's shape (or its grid's hull) in the world
+    QueryShape shape;
+    float margin;
+    bool cached = false;  // contacts found from cached chunks (else queried again in pair order)
+    bool wet = false;
+    WaterContact water;
+  };
+  std::vector<TerrainQuery> terrainQueries_;
   PairCache pairCache_;
   ContactSolver solver_;
   Islands islands_;

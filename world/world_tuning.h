@@ -78,6 +78,9 @@ inline constexpr uint32_t kMaxColours = 64;
 inline constexpr uint32_t kColourGrain = 64;
 /// Pairs per job in contact generation (a pair may be a grid query of many bricks).
 inline constexpr uint32_t kPairGrain = 4;
+/// Fewest pairs per job of the terrain queries: one (a query meets a few chunks' triangles, tens
+/// of microseconds for a body lying in a pile of them).
+inline constexpr uint32_t kMinTerrainGrain = 1;
 /// Rays per job in the scene's ray load.
 inline constexpr uint32_t kRayGrain = 64;
 

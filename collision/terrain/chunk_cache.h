@@ -48,6 +48,12 @@ class ChunkCache {
 
   /// The chunk's collision data, meshed and built now if not cached.
   const ChunkCollision& get(const Int3& chunk, const VoxelTerrain& voxels, float voxelSize);
+  /// The chunk's data if cached, else nullptr. Reads only (no LRU update, no counters): safe on
+  /// many threads at once while nothing calls the mutating functions.
+  const ChunkCollision* find(const Int3& chunk) const {
+    const uint32_t e = index_.find(chunkKey(chunk));
+    return e == kInvalidIndex ? nullptr : &entries_[e].data;
+  }
   /// True if the chunk's data is cached (does not touch the LRU order).
   bool contains(const Int3& chunk) const { return index_.find(chunkKey(chunk)) != kInvalidIndex; }
   /// Drops the chunk's data (voxels in its 10^3 neighbourhood changed).

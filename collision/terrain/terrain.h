@@ -53,6 +53,8 @@ class Terrain {
   ChunkCache& cache() { return cache_; }
   /// Narrowphase data of a chunk, built on demand.
   const ChunkCollision& chunkCollision(const Int3& chunk) { return cache_.get(chunk, voxels_, voxelSize_); }
+  /// The chunk's collision data if the cache holds it, else nullptr (reads only: thread-safe).
+  const ChunkCollision* cachedChunkCollision(const Int3& chunk) const { return cache_.find(chunk); }
 
   /// Edge length of a voxel in terrain-local units.
   float voxelSize() const { return voxelSize_; }

@@ -147,20 +147,37 @@ void dropInteriorEdgeContacts(std::vector<Contact>& out, size_t begin, const std
   out.resize(w);
 }
 
-size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec,
-                       std::vector<Contact>& out) {
-  validatePlacedShape(shape, pose, "terrainContacts");
-  requireInRange(spec, 0.0, 1e6, "terrainContacts", "speculativeDistance");
-  const size_t before = out.size();
-  // Face normal (world) of the triangle behind each contact appended by this call.
-  // note: thread_local scratch, so steady-state queries do not allocate.
-  thread_local std::vector<Vec3f> faceNormals;
-  faceNormals.clear();
+namespace {
+
+// Calls f(chunk) for every chunk with solid triangles that a query of `shape` at `pose` within
+// `spec` reads, in the terrain broadphase's order; f returns false to stop.
+template <class F>
+void forEachQueriedChunk(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec, F&& f) {
   const RigidTransform& place = terrain.placement();
   const LocalShape inTerrain = placeShape(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation));
   const Aabb terrainBox = Aabb::fromCenterHalf(inTerrain.centre, inTerrain.halfBounds).expanded(spec);
   VoxelRange range;
-  if (!terrain.broadphase().voxelRangeOf(terrainBox, terrain.voxelSize(), range)) return 0;
+  if (!terrain.broadphase().voxelRangeOf(terrainBox, terrain.voxelSize(), range)) return;
+  bool going = true;
+  terrain.broadphase().forEachTouchedChunk(range, [&](const Int3& chunk, const TerrainOverlap& o) {
+    if (!going || !o.solid || terrain.broadphase().kind(chunk) != ChunkMaskKind::Masked) return;
+    going = f(chunk);
+  });
+}
+
+// The contacts, with chunk data from lookup(chunk) (nullptr: not available, the query stops
+// and returns false with `out` as it was).
+template <class Lookup>
+bool contactsWith(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec, std::vector<Contact>& out,
+                  Lookup&& lookup) {
+  const char* const where = "terrainContacts";
+  validatePlacedShape(shape, pose, where);
+  requireInRange(spec, 0.0, 1e6, where, "speculativeDistance");
+  const size_t before = out.size();
+  // Face normal (world) of the triangle behind each contact appended by this call.
+  // note: thread_local scratch, so steady-state queries do not allocate, on any thread.
+  thread_local std::vector<Vec3f> faceNormals;
+  faceNormals.clear();
 
   // Bullet shapes are made once per query; only the triangle changes per pair.
   btBoxShape btBox(toBt(shape.halfExtents.cwiseMax(Vec3f::Constant(1e-6f))));
@@ -172,10 +189,12 @@ size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTra
     btHull.setMargin(0.f);
   }
 
-  terrain.broadphase().forEachTouchedChunk(range, [&](const Int3& chunk, const TerrainOverlap& o) {
-    if (!o.solid || terrain.broadphase().kind(chunk) != ChunkMaskKind::Masked) return;
-    const ChunkCollision& cc = terrain.chunkCollision(chunk);
-    if (cc.mesh.triangleCount() == 0) return;
+  bool complete = true;
+  forEachQueriedChunk(terrain, shape, pose, spec, [&](const Int3& chunk) {
+    const ChunkCollision* found = lookup(chunk);
+    if (!found) return complete = false;
+    const ChunkCollision& cc = *found;
+    if (cc.mesh.triangleCount() == 0) return true;
     const RigidTransform xf = terrain.chunkTransform(chunk);
     const Quatf localRot = xf.rotationToLocal(pose.rotation);
     const LocalShape ls = placeShape(shape, xf.pointToLocal(pose.translation), localRot);
@@ -215,7 +234,12 @@ size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTra
         faceNormals.push_back(xf.directionToWorld(n));
       }
     });
+    return true;
   });
+  if (!complete) {
+    out.resize(before);
+    return false;
+  }
   dropInteriorEdgeContacts(out, before, faceNormals);
   // A point shared by several triangles (quad diagonals, corners) is reported by each: keep
   // one. Done after the interior-edge filter, which needs every triangle's face normal.
@@ -228,7 +252,21 @@ size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTra
     if (!duplicate) out[w++] = out[i];
   }
   out.resize(w);
+  return true;
+}
+
+}  // namespace
+
+size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec,
+                       std::vector<Contact>& out) {
+  const size_t before = out.size();
+  contactsWith(terrain, shape, pose, spec, out, [&](const Int3& chunk) { return &terrain.chunkCollision(chunk); });
   return out.size() - before;
+}
+
+bool terrainContactsCached(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec,
+                           std::vector<Contact>& out) {
+  return contactsWith(terrain, shape, pose, spec, out, [&](const Int3& chunk) { return terrain.cachedChunkCollision(chunk); });
 }
 
 bool terrainWaterContact(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out) {

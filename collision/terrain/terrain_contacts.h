@@ -17,7 +17,8 @@
 /// its 4 supporting corners rather than one point.
 /// Contact::featureB = (chunk coordinates mod 64/64/128 packed in 19 bits) << 13 | triangle:
 /// stable while the chunk is unchanged, unique among nearby chunks.
-/// Thread safety: as Terrain (the cache is filled).
+/// Thread safety: terrainContacts as Terrain (it fills the cache), one thread at a time;
+/// terrainContactsCached and terrainWaterContact only read.
 #include <cstdint>
 #include <vector>
 
@@ -34,6 +35,14 @@ namespace bw {
 /// pose or distance.
 size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float speculativeDistance,
                        std::vector<Contact>& out);
+
+/// The same contacts from chunk data already in the terrain's cache, reading nothing else:
+/// safe on any number of threads at once (while nothing edits the terrain or fills its cache).
+/// Returns false, appending nothing, if a chunk the query needs is not cached (never meshed,
+/// or evicted): the caller then runs terrainContacts on one thread. Cache hits here do not
+/// refresh the cache's LRU order.
+bool terrainContactsCached(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float speculativeDistance,
+                           std::vector<Contact>& out);
 
 /// Interior edges: a shape resting on a flat area made of many triangles touches the
 /// neighbours of its supporting triangle at their shared (quad diagonal or quad border) edges,

@@ -12,6 +12,7 @@
 #include <sys/resource.h>
 #include <vector>
 
+#include "cli/progress_watch.h"
 #include "cli/render_figures.h"
 #include "cli/series.h"
 #include "world/bullet_baseline.h"
@@ -167,8 +168,11 @@ int runScene(const SceneRunOptions& o) {
     throw SceneError(path + ": --submission " + o.submission + ": the scene declares no attachments (no render thread to submit to)");
   if (!o.tracePath.empty() && !std::ofstream(o.tracePath))
     throw std::runtime_error("--trace: cannot write " + o.tracePath);  // checked before the run, not after it
+  ProgressWatch watch(o.progress);
   const auto tBuild = Clock::now();
+  watch.begin("building the scene");
   World world(scene, o.threads, submission);
+  watch.end();
   const double buildMs = std::chrono::duration<double, std::milli>(Clock::now() - tBuild).count();
   const uint32_t frames = o.frames ? o.frames : scene.settings.frames;
 
@@ -188,10 +192,14 @@ int runScene(const SceneRunOptions& o) {
   ContainmentTracker containment(world);  // updated after each step, outside its timing
   RenderFigures render;
   const auto tRun = Clock::now();
+  double simulationMs = 0;  // the steps' own time; the rest of the run is bookkeeping
   for (uint32_t f = 0; f < frames; ++f) {
     if (o.driftAfter && f == o.driftAfter) settled = world.bodies().position;
+    watch.begin("frame", f + 1, frames);
     world.step();
+    watch.end();
     const StepStats& s = world.lastStats();
+    simulationMs += s.totalMs;
     containment.update();
     endDeepest = deepestContact(world);
     deepest = std::max(deepest, endDeepest);
@@ -229,6 +237,9 @@ int runScene(const SceneRunOptions& o) {
     span += ws.spanMs;
   }
   if (!o.tracePath.empty()) world.profiler().writeChromeTrace(o.tracePath);
+  // Bookkeeping: everything the run did besides stepping (containment checks, deepest contact,
+  // counters, CSV, work/span, the trace), against the simulation's own time.
+  const double bookkeepingMs = std::chrono::duration<double, std::milli>(Clock::now() - tRun).count() - simulationMs;
 
   // Where the dynamic bodies ended up: at rest, still moving, and the lowest one (a body far
   // below everything would have fallen through).
@@ -275,7 +286,10 @@ int runScene(const SceneRunOptions& o) {
                      {"end_penetration_m", endDeepest},
                      {"bodies_started_in_solid", world.startedInSolid()},
                      {"bodies_being_pushed_out", world.depenetratingCount()},
-                     {"state_hash", world.stateHash()}};
+                     {"state_hash", world.stateHash()},
+                     {"simulation_ms", simulationMs},
+                     {"bookkeeping_ms", bookkeepingMs},
+                     {"bookkeeping_share", bookkeepingMs / std::max(simulationMs, 1e-9)}};
     if (inside.count()) j["inside_solid"] = insideSolidList(inside, bodies.position);
     if (!settled.empty()) j["drift_after_frame"] = {{"frame", o.driftAfter}, {"max_displacement_m", drift}};
     if (!scene.terrains.empty()) {
@@ -312,6 +326,8 @@ int runScene(const SceneRunOptions& o) {
     if (s == &rays && rayCount == 0) continue;
     std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
   }
+  std::printf("  simulation %.0f ms; bookkeeping (containment, counters, CSV, work/span, trace) %.0f ms = %.1f%% of it\n",
+              simulationMs, bookkeepingMs, 100.0 * bookkeepingMs / std::max(simulationMs, 1e-9));
   std::printf("  per frame: %.0f pairs (%.0f reused from the pair cache), %.0f contacts, %.0f box tests\n", double(pairs) / frames,
               double(reused) / frames, double(contactCount) / frames, double(boxTests) / frames);
   std::printf("  islands: largest %u contacts; %.1f per frame split by colour over the threads\n", largestIsland,

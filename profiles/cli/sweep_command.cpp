@@ -24,7 +24,14 @@ struct SweepRow {
   double medianMs, p95Ms, totalS;
   uint64_t hash;
   double workMs, spanMs;
-  WorkSpan perFrame;  // summed stage figures over the run
+  std::vector<WorkSpan> frameSpans;  // per frame
+  // Work over the sum of each frame's bound at p threads (stages differ from frame to frame,
+  // so they are not summed across frames first).
+  double speedupBound(int p) const {
+    double bound = 0;
+    for (const WorkSpan& ws : frameSpans) bound += ws.boundMs(p);
+    return bound > 0 ? workMs / bound : 1.0;
+  }
   RenderFigures render;  // scenes with attachments
   bool hasRender = false;
 };
@@ -43,21 +50,12 @@ SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames, Subm
   std::sort(t.begin(), t.end());
   r.medianMs = t[t.size() / 2];
   r.p95Ms = t[std::min(t.size() - 1, size_t(double(t.size()) * 0.95))];
-  // Sum the per-frame bounds: the run's time with p threads is at least the sum over frames.
-  for (const WorkSpan& ws : world.profiler().workSpans(frames)) {
+  // The run's time with p threads is at least the sum over frames of each frame's bound.
+  r.frameSpans = world.profiler().workSpans(frames);
+  for (const WorkSpan& ws : r.frameSpans) {
     r.workMs += ws.workMs;
     r.spanMs += ws.spanMs;
-    if (r.perFrame.stageWorkMs.size() < ws.stageWorkMs.size()) {
-      r.perFrame.stageWorkMs.resize(ws.stageWorkMs.size(), 0.0);
-      r.perFrame.stageSpanMs.resize(ws.stageSpanMs.size(), 0.0);
-    }
-    for (size_t s = 0; s < ws.stageWorkMs.size(); ++s) {
-      r.perFrame.stageWorkMs[s] += ws.stageWorkMs[s];
-      r.perFrame.stageSpanMs[s] += ws.stageSpanMs[s];
-    }
   }
-  r.perFrame.workMs = r.workMs;
-  r.perFrame.spanMs = r.spanMs;
   if (world.render()) {
     render.finish(world);
     r.render = std::move(render);
@@ -112,14 +110,14 @@ CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured
       out << "scene,threads,frames,median_ms,p95_ms,total_s,measured_speedup,bound_speedup,state_hash\n";
       for (const SweepRow& r : rows)
         out << desc.name << "," << r.threads << "," << n << "," << r.medianMs << "," << r.p95Ms << "," << r.totalS << ","
-            << one.totalS / r.totalS << "," << one.perFrame.speedupBound(r.threads) << "," << r.hash << "\n";
+            << one.totalS / r.totalS << "," << one.speedupBound(r.threads) << "," << r.hash << "\n";
     }
     if (*json) {
       nlohmann::json j{{"scene", desc.name}, {"frames", n}, {"state_hash_identical", sameHash}};
       for (const SweepRow& r : rows)
         j["runs"].push_back({{"threads", r.threads}, {"median_ms", r.medianMs}, {"p95_ms", r.p95Ms}, {"total_s", r.totalS},
                              {"measured_speedup", one.totalS / r.totalS}, {"state_hash", r.hash}});
-      for (int p : {2, 4, 8, 16}) j["bound_speedup"][std::to_string(p)] = one.perFrame.speedupBound(p);
+      for (int p : {2, 4, 8, 16}) j["bound_speedup"][std::to_string(p)] = one.speedupBound(p);
       j["work_ms"] = one.workMs;
       j["span_ms"] = one.spanMs;
       if (one.hasRender) {
@@ -148,10 +146,10 @@ CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured
     std::printf("  %-8s %10s %10s %9s %9s %9s  %s\n", "threads", "median", "p95", "total", "measured", "bound", "state hash");
     for (const SweepRow& r : rows)
       std::printf("  %-8d %7.3f ms %7.3f ms %7.2f s %8.2fx %8.2fx  %016llx\n", r.threads, r.medianMs, r.p95Ms, r.totalS,
-                  one.totalS / r.totalS, one.perFrame.speedupBound(r.threads), (unsigned long long)r.hash);
+                  one.totalS / r.totalS, one.speedupBound(r.threads), (unsigned long long)r.hash);
     std::printf("  from the 1-thread run: work %.1f ms, span %.1f ms; speedup bound at 2/4/8/16 threads: %.2fx %.2fx %.2fx %.2fx\n",
-                one.workMs, one.spanMs, one.perFrame.speedupBound(2), one.perFrame.speedupBound(4), one.perFrame.speedupBound(8),
-                one.perFrame.speedupBound(16));
+                one.workMs, one.spanMs, one.speedupBound(2), one.speedupBound(4), one.speedupBound(8),
+                one.speedupBound(16));
     if (one.hasRender) {
       std::printf("  render frame (transform update + submission + commit); submission + commit per frame, measured and\n"
                   "  predicted from each mode's 1-thread work/span (the mutex queue's pushes are serial: all in the span):\n");

@@ -33,10 +33,10 @@ void solveOnce(ContactSolver& solver, BodyStore& bodies, const std::vector<BodyP
   Islands islands;
   islands.build(solver.contacts(), bodies.motion, jobs, profiler, 0);
   islands.groupContacts(solver.contacts(), bodies.motion);
-  solver.loadBodies(bodies);
+  solver.loadBodies(bodies, jobs, profiler);
   solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
   solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);
-  solver.storeBodies(bodies);
+  solver.storeBodies(bodies, jobs, profiler);
 }
 
 TEST(ContactSolver, WarmStartMatchesPairAndFeatureAtFullWidth) {
