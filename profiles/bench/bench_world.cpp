@@ -2,12 +2,52 @@
 //
 //   build/release/bin/bench_world --benchmark_counters_tabular=true
 //
-// Broadphase/<method>/<bodies>: bodies falling onto a few huge static grids (the shape of the
-// shipped scenes), moved every frame, pairs recomputed every frame:
-//   SweepAndPrune  - the world's choice (sorted order kept between frames)
-//   OctoBVH        - our OctoBVH over the bodies, every body updated then queried each frame
-//   BruteForce     - all pairs (the floor any method must beat)
-// Counters: pairs per frame, interval/box tests per frame.
+// Broadphase/<method>/<n>/iterations:<frames>/manual_time: issue 17's question, which
+// broadphase at 1k, 10k, 100k and 1M bodies. n moving 0.5 m boxes fall onto huge static grids
+// (400 x 400 x 40 m boxes, the shape of the shipped scenes), moved every frame (velocities flip
+// every 120 frames), pairs recomputed every frame. The region is 500 m * sqrt(n / 5000) square
+// with 4 grids per 500 x 500 m (at least 4): z stays 0-60 m, so the area follows n and the
+// density stays constant. Every method runs the same frames (600, 120, 24, 12 at 1k-1M); its
+// time is the pair finding alone (manual time: moving the bodies is left out):
+//   SweepAndPrune     - the world's choice, given a JobSystem(1): its parallel path (chunks,
+//                       job-system sorts) on one thread
+//   btDbvtBroadphase  - Bullet's default broadphase as an expert sets it up for many moving
+//                       bodies: proxies created once (statics in group StaticFilter, so no
+//                       static-static pairs), setAabb for every moved proxy, then
+//                       calculateOverlappingPairs and the pairs read from its pair cache;
+//                       velocity prediction 2, the fastest of the settings tried (below)
+//   btAxisSweep3      - Bullet's incremental sweep and prune, bt32BitAxisSweep3 (room for every
+//                       proxy), world box 50 m around the scene, no raycast accelerator (it
+//                       would mirror every proxy into a dbvt). Up to 10k only: creating a
+//                       proxy sorts its edges in from the end of each axis, so the first frame
+//                       is quadratic (10k: ~1 s; 100k, run once: 152 s for the first frame,
+//                       then 268 ms a frame, 9x SweepAndPrune; 1M: hours)
+//   OctoBVH           - our OctoBVH over all bodies, bulk-loaded, then every frame each moving
+//                       body updated, then each queried
+//   BruteForce        - all pairs, up to 10k (the floor any method must beat)
+// Counters:
+//   pairs          - overlapping pairs per frame (static-static ones excepted; Bullet's boxes
+//                    are enlarged, so its cached pairs go through the exact box test, timed).
+//                    Checked against SweepAndPrune's serial path (no job system) run outside
+//                    the timing: the count every frame, the pairs themselves at the first and
+//                    last frames. A row whose pairs differ fails (SkipWithError, an error line,
+//                    and bench_world exits 1).
+//   tests          - interval and box comparisons per frame (nan: Bullet does not count them)
+//   cache_pairs    - pairs in Bullet's cache before the exact test (nan for our methods)
+//   first_frame_ms - the first frame from a fresh structure (every proxy created or loaded,
+//                    the pairs found), measured once before the timed frames; issue 17's goal:
+//                    100k <= 100 ms, 1M <= 1.5 s on one thread
+// Only SweepAndPrune sorts its pairs (its determinism contract); the others leave theirs in
+// their own order. The summary prints, per n, each method's frame and first-frame times and
+// their ratios to SweepAndPrune's.
+//
+// BulletDbvtSettings/<setting>/<n> (10k and 100k; not matched by --benchmark_filter=Broadphase):
+// the btDbvtBroadphase settings tried, same workload and counters. static-filter is the base
+// (no-static-filter puts statics in DefaultFilter); deferred-collide sets m_deferedcollide (pairs
+// found tree against tree in collide() instead of per updated proxy); optimize calls optimize()
+// after creating the proxies; dupdates-1 re-inserts 1% of the moving tree per frame
+// (m_dupdates); prediction-<p> is setVelocityPrediction(p) (leaves enlarged by p half-extents
+// in the direction of motion, so a moving box leaves its leaf less often).
 //
 // WorldFrame/<engine>/<scene>: the shipped scene (crates_on_grid, city_rain, lighthouse) for
 // its own frame count (300: landing and rest) on one thread, from the same initial state for
@@ -33,10 +73,16 @@
 // summary prints per-object / batched.
 #include <benchmark/benchmark.h>
 
+#include <btBulletCollisionCommon.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdint>
+#include <limits>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "collision/core/seeded_random.h"
@@ -50,10 +96,17 @@ namespace {
 
 using namespace bw;
 
+// ---------------------------------------------------------------- broadphase at 1k-1M bodies
+
+// The workload: n small moving boxes (0.5 m) falling onto huge static grids (400 x 400 x 40 m
+// boxes), the shape of the shipped scenes. The region grows with n at constant density: x and
+// y span side = 500 m * sqrt(n / 5000) (z stays 0-60 m, so the area, not the volume, follows
+// n), and there are 4 grids per 500 x 500 m (at least 4). Proxies 0..grids-1 are the grids.
 struct Bodies {
   std::vector<WorldAabb> bounds;
   std::vector<uint8_t> isStatic;
   std::vector<Vec3d> velocity;
+  uint32_t grids = 0;
   uint64_t frame = 0;
   // Bodies move back and forth (velocities flip every 120 frames) so every benchmark, whatever
   // its iteration count, averages over the same distribution of positions.
@@ -70,9 +123,11 @@ struct Bodies {
 Bodies makeBodies(uint32_t n) {
   SeededRandom r(1);
   Bodies b;
-  for (uint32_t i = 0; i < n; ++i) {
-    const bool grid = i < 4;  // four large static grids
-    const double cx = r.uniform(0, 500), cy = r.uniform(0, 500), cz = grid ? 10 : r.uniform(0, 60);  // in this order
+  const double side = 500.0 * std::sqrt(double(n) / 5000.0);
+  b.grids = std::max<uint32_t>(4, uint32_t(std::lround(4.0 * side * side / (500.0 * 500.0))));
+  for (uint32_t i = 0; i < b.grids + n; ++i) {
+    const bool grid = i < b.grids;
+    const double cx = r.uniform(0, side), cy = r.uniform(0, side), cz = grid ? 10 : r.uniform(0, 60);  // in this order
     const Vec3d c(cx, cy, cz);
     const Vec3d h = grid ? Vec3d(200, 200, 20) : Vec3d::Constant(0.25);
     b.bounds.push_back({c - h, c + h});
@@ -87,64 +142,356 @@ Bodies makeBodies(uint32_t n) {
   return b;
 }
 
-void Broadphase_SweepAndPrune(benchmark::State& state) {
-  Bodies b = makeBodies(uint32_t(state.range(0)));
+const uint32_t kBroadphaseCounts[] = {1000, 10000, 100000, 1000000};
+// Frames per row (the benchmark's iterations): every method runs the same frames of the same
+// motion, so the rows average over identical work.
+int64_t framesFor(uint32_t n) { return n <= 1000 ? 600 : n <= 10000 ? 120 : n <= 100000 ? 24 : 12; }
+
+// The reference: SweepAndPrune's serial path (no job system), run once per n outside every
+// timing, pair count per frame (frame 0 = the initial bounds, frame k = after k steps) and the
+// pairs of frame 0 and of the last frame a row runs. Every row's pairs are checked against it.
+struct Reference {
+  Bodies bodies;
   SweepAndPrune sap;
-  std::vector<BodyPair> pairs;
-  uint64_t tests = 0, found = 0;
-  for (auto _ : state) {
-    b.step();
-    sap.update(b.bounds, b.isStatic, pairs);
-    tests += sap.lastTests();
-    found += pairs.size();
+  std::vector<uint64_t> counts;
+  std::vector<BodyPair> first, last;
+  uint64_t lastFrame = 0;
+};
+
+Reference& reference(uint32_t n, uint64_t frames) {
+  static std::map<uint32_t, std::unique_ptr<Reference>> refs;
+  std::unique_ptr<Reference>& ref = refs[n];
+  if (!ref || ref->counts.size() > frames + 1) ref.reset();
+  if (!ref) {
+    ref = std::make_unique<Reference>();
+    ref->bodies = makeBodies(n);
   }
-  state.counters["pairs"] = benchmark::Counter(double(found), benchmark::Counter::kAvgIterations);
-  state.counters["tests"] = benchmark::Counter(double(tests), benchmark::Counter::kAvgIterations);
+  std::vector<BodyPair> pairs;
+  while (ref->counts.size() <= frames) {
+    if (!ref->counts.empty()) ref->bodies.step();
+    ref->sap.update(ref->bodies.bounds, ref->bodies.isStatic, pairs);
+    if (ref->counts.empty()) ref->first = pairs;
+    ref->counts.push_back(pairs.size());
+    ref->last = pairs;
+    ref->lastFrame = ref->counts.size() - 1;
+  }
+  return *ref;
 }
 
-void Broadphase_OctoBVH(benchmark::State& state) {
-  Bodies b = makeBodies(uint32_t(state.range(0)));
-  OctoBvh tree(OctoBvh::Config{uint32_t(b.bounds.size() + 64)});
-  std::vector<uint32_t> handles;
-  auto local = [](const WorldAabb& w) { return Aabb{w.min.cast<float>(), w.max.cast<float>()}; };
-  for (uint32_t i = 0; i < b.bounds.size(); ++i) handles.push_back(tree.insert(local(b.bounds[i]), 1, i));
+bool& broadphaseMismatch() {
+  static bool any = false;
+  return any;
+}
+
+// The pairs a method found for a frame, as the reference has them (sorted, a < b).
+bool samePairs(std::vector<BodyPair> got, const std::vector<BodyPair>& want) {
+  std::sort(got.begin(), got.end());
+  return got == want;
+}
+
+struct BroadphaseFigures {
+  double frameMs = 0, firstMs = 0, pairs = 0;
+};
+std::map<std::string, BroadphaseFigures>& broadphaseFigures() {  // "<method>/<n>" -> figures
+  static std::map<std::string, BroadphaseFigures> m;
+  return m;
+}
+
+double msSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+// One JobSystem(1) for the process (a JobSystem sets oneTBB's process-wide limit; the World
+// rows make their own of the same thread count).
+JobSystem& oneThread() {
+  static JobSystem jobs(1);
+  return jobs;
+}
+
+// A broadphase method under test: first(bodies, pairs) builds from scratch and finds frame 0's
+// pairs; frame(bodies, pairs) finds the pairs after the bodies moved. Both replace `pairs` with
+// every pair of overlapping bounds not both static, each once, a < b, in any order. tests()
+// is the comparisons of the last call (NaN where the method does not count them), cachePairs()
+// the pairs the method keeps before the exact test (NaN where it keeps none).
+template <class Method>
+void runBroadphase(benchmark::State& state, const char* name) {
+  const uint32_t n = uint32_t(state.range(0));
+  const uint64_t frames = uint64_t(state.max_iterations);
+  const Reference& ref = reference(n, frames);
+  Bodies b = makeBodies(n);
   std::vector<BodyPair> pairs;
-  uint64_t found = 0;
-  QueryStats st;
+  const auto fail = [&](const std::string& what) {
+    broadphaseMismatch() = true;
+    std::fprintf(stderr, "Broadphase/%s/%u: %s\n", name, n, what.c_str());
+    state.SkipWithError(what.c_str());
+  };
+  oneThread();  // created (oneTBB's arena started) before any timing
+  Method method;
+  const auto t0 = std::chrono::steady_clock::now();
+  method.first(b, pairs);
+  const double firstMs = msSince(t0);
+  if (!samePairs(pairs, ref.first)) {
+    fail("frame 0: " + std::to_string(pairs.size()) + " pairs, SweepAndPrune has " + std::to_string(ref.first.size()));
+    return;
+  }
+  double found = 0, tests = 0, cache = 0, totalMs = 0;
+  bool ok = true;
   for (auto _ : state) {
     b.step();
-    for (uint32_t i = 0; i < b.bounds.size(); ++i)
-      if (!b.isStatic[i]) tree.update(handles[i], local(b.bounds[i]), 1);
+    const auto t = std::chrono::steady_clock::now();
+    method.frame(b, pairs);
+    const double ms = msSince(t);
+    state.SetIterationTime(ms / 1000);
+    totalMs += ms;
+    found += double(pairs.size());
+    tests += method.tests();
+    cache += method.cachePairs();
+    if (pairs.size() != ref.counts[b.frame]) {
+      fail("frame " + std::to_string(b.frame) + ": " + std::to_string(pairs.size()) + " pairs, SweepAndPrune has " +
+           std::to_string(ref.counts[b.frame]));
+      ok = false;
+      break;
+    }
+  }
+  if (!ok) return;
+  if (b.frame == ref.lastFrame && !samePairs(pairs, ref.last)) {
+    fail("frame " + std::to_string(b.frame) + ": other pairs than SweepAndPrune's (same count)");
+    return;
+  }
+  const double iters = double(std::max<int64_t>(1, state.iterations()));
+  state.counters["pairs"] = found / iters;
+  state.counters["tests"] = tests / iters;
+  state.counters["cache_pairs"] = cache / iters;
+  state.counters["first_frame_ms"] = firstMs;
+  broadphaseFigures()[std::string(name) + "/" + std::to_string(n)] = {totalMs / iters, firstMs, found / iters};
+}
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Ours: SweepAndPrune on JobSystem(1), so the parallel code path (chunks, the job-system sample
+// sorts) runs, on one thread.
+struct OurSweepAndPrune {
+  SweepAndPrune sap;
+  void first(const Bodies& b, std::vector<BodyPair>& pairs) { sap.update(b.bounds, b.isStatic, pairs, &oneThread()); }
+  void frame(const Bodies& b, std::vector<BodyPair>& pairs) { sap.update(b.bounds, b.isStatic, pairs, &oneThread()); }
+  double tests() const { return double(sap.lastTests()); }
+  double cachePairs() const { return kNaN; }
+};
+
+btVector3 bt(const Vec3d& v) { return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z())); }
+
+// Bullet's pair cache, read as a user reads it: every cached pair whose proxies' current boxes
+// overlap (Bullet keeps pairs of its enlarged boxes, and drops stale ones a share per frame;
+// rounding to float only widens, so the cache holds every overlapping pair). Proxy user
+// pointers are body index + 1.
+void readBulletPairs(btOverlappingPairCache& cache, const Bodies& b, std::vector<BodyPair>& pairs) {
+  pairs.clear();
+  const int count = cache.getNumOverlappingPairs();
+  const btBroadphasePair* p = cache.getOverlappingPairArrayPtr();
+  for (int k = 0; k < count; ++k) {
+    const uint32_t i = uint32_t(reinterpret_cast<uintptr_t>(p[k].m_pProxy0->m_clientObject) - 1);
+    const uint32_t j = uint32_t(reinterpret_cast<uintptr_t>(p[k].m_pProxy1->m_clientObject) - 1);
+    if ((b.isStatic[i] && b.isStatic[j]) || !b.bounds[i].overlaps(b.bounds[j])) continue;
+    pairs.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
+  }
+}
+
+// Collision filters as Bullet sets them for static objects: static proxies in group
+// StaticFilter with every group but StaticFilter in their mask, so static-static pairs never
+// enter the cache; with staticFilter off, every proxy is in DefaultFilter with mask AllFilter.
+void bulletFilter(const Bodies& b, uint32_t i, bool staticFilter, int& group, int& mask) {
+  const bool s = staticFilter && b.isStatic[i];
+  group = s ? int(btBroadphaseProxy::StaticFilter) : int(btBroadphaseProxy::DefaultFilter);
+  mask = s ? int(btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter) : int(btBroadphaseProxy::AllFilter);
+}
+
+// btDbvtBroadphase settings tried (BulletDbvtSettings/* rows; the Broadphase/btDbvtBroadphase
+// rows use kDbvtChosen).
+struct DbvtSettings {
+  bool staticFilter = true;   // static proxies in StaticFilter (static-static pairs skipped)
+  bool deferred = false;      // m_deferedcollide: pairs found by tree-vs-tree in collide()
+  bool optimize = false;      // optimize() (top-down rebuild of both trees) after the proxies are created
+  int dupdates = 0;           // m_dupdates: % of the moving tree re-inserted per frame
+  float prediction = 0;       // setVelocityPrediction
+};
+
+struct BulletWorldParts {  // what calculateOverlappingPairs needs besides the broadphase
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+};
+
+template <const DbvtSettings& S>
+struct BulletDbvt {
+  BulletWorldParts parts;
+  std::unique_ptr<btDbvtBroadphase> bp;
+  std::vector<btBroadphaseProxy*> proxies;
+  double cached = 0;
+  void first(const Bodies& b, std::vector<BodyPair>& pairs) {
+    bp = std::make_unique<btDbvtBroadphase>();
+    bp->m_deferedcollide = S.deferred;
+    bp->m_dupdates = S.dupdates;
+    bp->setVelocityPrediction(S.prediction);
+    proxies.resize(b.bounds.size());
+    for (uint32_t i = 0; i < b.bounds.size(); ++i) {
+      int group, mask;
+      bulletFilter(b, i, S.staticFilter, group, mask);
+      proxies[i] = bp->createProxy(bt(b.bounds[i].min), bt(b.bounds[i].max), BOX_SHAPE_PROXYTYPE,
+                                   reinterpret_cast<void*>(uintptr_t(i) + 1), group, mask, &parts.dispatcher);
+    }
+    if (S.optimize) bp->optimize();
+    bp->calculateOverlappingPairs(&parts.dispatcher);
+    read(b, pairs);
+  }
+  void frame(const Bodies& b, std::vector<BodyPair>& pairs) {
+    for (uint32_t i = b.grids; i < b.bounds.size(); ++i)  // the moving proxies: every one moved
+      bp->setAabb(proxies[i], bt(b.bounds[i].min), bt(b.bounds[i].max), &parts.dispatcher);
+    bp->calculateOverlappingPairs(&parts.dispatcher);
+    read(b, pairs);
+  }
+  void read(const Bodies& b, std::vector<BodyPair>& pairs) {
+    cached = bp->getOverlappingPairCache()->getNumOverlappingPairs();
+    readBulletPairs(*bp->getOverlappingPairCache(), b, pairs);
+  }
+  double tests() const { return kNaN; }
+  double cachePairs() const { return cached; }
+};
+
+constexpr DbvtSettings kDbvtNoFilter{.staticFilter = false};
+constexpr DbvtSettings kDbvtStatic{};
+constexpr DbvtSettings kDbvtDeferred{.deferred = true};
+constexpr DbvtSettings kDbvtOptimize{.optimize = true};
+constexpr DbvtSettings kDbvtDupdates{.dupdates = 1};
+constexpr DbvtSettings kDbvtPrediction{.prediction = 0.5f};
+constexpr DbvtSettings kDbvtDeferredOptimize{.deferred = true, .optimize = true};
+constexpr DbvtSettings kDbvtPrediction1{.prediction = 1};
+constexpr DbvtSettings kDbvtPrediction2{.prediction = 2};
+constexpr DbvtSettings kDbvtPrediction4{.prediction = 4};
+constexpr DbvtSettings kDbvtDeferredPrediction05{.deferred = true, .prediction = 0.5f};
+constexpr DbvtSettings kDbvtDeferredPrediction1{.deferred = true, .prediction = 1};
+constexpr DbvtSettings kDbvtDeferredPrediction2{.deferred = true, .prediction = 2};
+constexpr const DbvtSettings& kDbvtChosen = kDbvtPrediction2;
+
+// bt32BitAxisSweep3: Bullet's incremental sweep and prune (32-bit quantized edges, so it holds
+// far more than 1M handles), the world box 50 m around the scene, no raycast accelerator (it
+// would mirror every proxy into a second, dbvt, broadphase; nothing here casts rays).
+struct BulletAxisSweep {
+  BulletWorldParts parts;
+  std::unique_ptr<bt32BitAxisSweep3> bp;
+  std::vector<btBroadphaseProxy*> proxies;
+  double cached = 0;
+  void first(const Bodies& b, std::vector<BodyPair>& pairs) {
+    Vec3d lo = b.bounds[0].min, hi = b.bounds[0].max;
+    for (const WorldAabb& w : b.bounds) {
+      lo = lo.cwiseMin(w.min);
+      hi = hi.cwiseMax(w.max);
+    }
+    bp = std::make_unique<bt32BitAxisSweep3>(bt(lo - Vec3d::Constant(50)), bt(hi + Vec3d::Constant(50)),
+                                             unsigned(b.bounds.size() + 1), nullptr, true);
+    proxies.resize(b.bounds.size());
+    for (uint32_t i = 0; i < b.bounds.size(); ++i) {
+      int group, mask;
+      bulletFilter(b, i, true, group, mask);
+      proxies[i] = bp->createProxy(bt(b.bounds[i].min), bt(b.bounds[i].max), BOX_SHAPE_PROXYTYPE,
+                                   reinterpret_cast<void*>(uintptr_t(i) + 1), group, mask, &parts.dispatcher);
+    }
+    bp->calculateOverlappingPairs(&parts.dispatcher);
+    read(b, pairs);
+  }
+  void frame(const Bodies& b, std::vector<BodyPair>& pairs) {
+    for (uint32_t i = b.grids; i < b.bounds.size(); ++i)
+      bp->setAabb(proxies[i], bt(b.bounds[i].min), bt(b.bounds[i].max), &parts.dispatcher);
+    bp->calculateOverlappingPairs(&parts.dispatcher);
+    read(b, pairs);
+  }
+  void read(const Bodies& b, std::vector<BodyPair>& pairs) {
+    cached = bp->getOverlappingPairCache()->getNumOverlappingPairs();
+    readBulletPairs(*bp->getOverlappingPairCache(), b, pairs);
+  }
+  double tests() const { return kNaN; }
+  double cachePairs() const { return cached; }
+};
+
+// Our OctoBVH over all bodies (statics filter 2, moving 1): built in bulk, then every frame
+// each moving body updated, then each queried. Float boxes rounded outwards, candidates kept
+// by the exact double test.
+struct OctoBvhPerBody {
+  std::unique_ptr<OctoBvh> tree;
+  std::vector<uint32_t> handles;
+  QueryStats st;
+  static Aabb local(const WorldAabb& w) {
+    Aabb a;
+    for (int k = 0; k < 3; ++k) {
+      float lo = float(w.min[k]), hi = float(w.max[k]);
+      if (double(lo) > w.min[k]) lo = std::nextafter(lo, -std::numeric_limits<float>::infinity());
+      if (double(hi) < w.max[k]) hi = std::nextafter(hi, std::numeric_limits<float>::infinity());
+      a.min[k] = lo;
+      a.max[k] = hi;
+    }
+    return a;
+  }
+  void first(const Bodies& b, std::vector<BodyPair>& pairs) {
+    tree = std::make_unique<OctoBvh>(OctoBvh::Config{uint32_t(b.bounds.size() + 64)});
+    std::vector<Aabb> boxes;
+    std::vector<uint32_t> filters, payloads;
+    for (uint32_t i = 0; i < b.bounds.size(); ++i) {
+      boxes.push_back(local(b.bounds[i]));
+      filters.push_back(b.isStatic[i] ? 2 : 1);
+      payloads.push_back(i);
+    }
+    handles = tree->bulkLoad(boxes, filters, payloads);
+    query(b, pairs);
+  }
+  void frame(const Bodies& b, std::vector<BodyPair>& pairs) {
+    for (uint32_t i = b.grids; i < b.bounds.size(); ++i) tree->update(handles[i], local(b.bounds[i]), 1);
+    query(b, pairs);
+  }
+  void query(const Bodies& b, std::vector<BodyPair>& pairs) {
+    st = {};
     pairs.clear();
     for (uint32_t i = 0; i < b.bounds.size(); ++i) {
       if (b.isStatic[i]) continue;
-      tree.overlap(local(b.bounds[i]), 1, [&](uint32_t h) {
-        const uint32_t j = tree.payload(h);
-        if (j != i && (b.isStatic[j] || j > i)) pairs.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
+      tree->overlap(local(b.bounds[i]), 3, [&](uint32_t h) {
+        const uint32_t j = tree->payload(h);
+        if (j != i && (b.isStatic[j] || j > i) && b.bounds[i].overlaps(b.bounds[j])) pairs.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
       }, &st);
     }
-    std::sort(pairs.begin(), pairs.end());
-    found += pairs.size();
   }
-  state.counters["pairs"] = benchmark::Counter(double(found), benchmark::Counter::kAvgIterations);
-  state.counters["tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
-}
+  double tests() const { return double(st.boxTests); }
+  double cachePairs() const { return kNaN; }
+};
 
-void Broadphase_BruteForce(benchmark::State& state) {
-  Bodies b = makeBodies(uint32_t(state.range(0)));
-  std::vector<BodyPair> pairs;
-  uint64_t found = 0;
-  for (auto _ : state) {
-    b.step();
+// All pairs (the floor any method must beat).
+struct BruteForce {
+  uint64_t n = 0;
+  void first(const Bodies& b, std::vector<BodyPair>& pairs) { frame(b, pairs); }
+  void frame(const Bodies& b, std::vector<BodyPair>& pairs) {
     pairs.clear();
-    const uint32_t n = uint32_t(b.bounds.size());
+    n = b.bounds.size();
     for (uint32_t i = 0; i < n; ++i)
       for (uint32_t j = i + 1; j < n; ++j)
         if (!(b.isStatic[i] && b.isStatic[j]) && b.bounds[i].overlaps(b.bounds[j])) pairs.push_back({i, j});
-    found += pairs.size();
   }
-  state.counters["pairs"] = benchmark::Counter(double(found), benchmark::Counter::kAvgIterations);
-  state.counters["tests"] = double(state.range(0)) * double(state.range(0) - 1) / 2;
+  double tests() const { return double(n) * double(n - 1) / 2; }
+  double cachePairs() const { return kNaN; }
+};
+
+void printBroadphaseRatios() {
+  const auto& m = broadphaseFigures();
+  const auto key = [](const char* method, uint32_t n) { return std::string(method) + '/' + std::to_string(n); };
+  for (uint32_t n : kBroadphaseCounts) {
+    if (!m.count(key("SweepAndPrune", n))) continue;
+    const BroadphaseFigures& ours = m.at(key("SweepAndPrune", n));
+    std::printf("broadphase, %u moving bodies (%.0f pairs): SweepAndPrune %.3f ms a frame, first frame %.1f ms", n, ours.pairs,
+                ours.frameMs, ours.firstMs);
+    for (const char* other : {"btDbvtBroadphase", "btAxisSweep3", "OctoBVH", "BruteForce"}) {
+      if (!m.count(key(other, n))) continue;
+      const BroadphaseFigures& f = m.at(key(other, n));
+      std::printf("; %s %.3f ms (%.1fx), first %.1f ms (%.1fx)", other, f.frameMs, f.frameMs / std::max(ours.frameMs, 1e-9), f.firstMs,
+                  f.firstMs / std::max(ours.firstMs, 1e-9));
+    }
+    std::printf("\n");
+  }
+  if (broadphaseMismatch()) std::printf("broadphase: a method's pairs differ from SweepAndPrune's (see the errors above)\n");
 }
 
 
@@ -261,13 +608,44 @@ void printWorldRatios() {
   }
 }
 
-BENCHMARK(Broadphase_SweepAndPrune)->Arg(1000)->Arg(2000)->Arg(5000)->Unit(benchmark::kMicrosecond);
-BENCHMARK(Broadphase_OctoBVH)->Arg(1000)->Arg(2000)->Arg(5000)->Unit(benchmark::kMicrosecond);
-BENCHMARK(Broadphase_BruteForce)->Arg(1000)->Arg(2000)->Arg(5000)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Broadphase rows: per method, every body count; the same frames (iterations) for every method.
+  const auto add = [](const std::string& name, uint32_t n, void (*fn)(benchmark::State&)) {
+    benchmark::RegisterBenchmark(name.c_str(), fn)->Arg(n)->Iterations(framesFor(n))->UseManualTime()->Unit(benchmark::kMillisecond);
+  };
+  for (uint32_t n : kBroadphaseCounts)
+    add("Broadphase/SweepAndPrune", n, [](benchmark::State& s) { runBroadphase<OurSweepAndPrune>(s, "SweepAndPrune"); });
+  for (uint32_t n : kBroadphaseCounts)
+    add("Broadphase/btDbvtBroadphase", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtChosen>>(s, "btDbvtBroadphase"); });
+  for (uint32_t n : kBroadphaseCounts)
+    if (n <= 10000) add("Broadphase/btAxisSweep3", n, [](benchmark::State& s) { runBroadphase<BulletAxisSweep>(s, "btAxisSweep3"); });
+  for (uint32_t n : kBroadphaseCounts)
+    add("Broadphase/OctoBVH", n, [](benchmark::State& s) { runBroadphase<OctoBvhPerBody>(s, "OctoBVH"); });
+  for (uint32_t n : kBroadphaseCounts)
+    if (n <= 10000) add("Broadphase/BruteForce", n, [](benchmark::State& s) { runBroadphase<BruteForce>(s, "BruteForce"); });
+  // The btDbvtBroadphase settings tried (not matched by --benchmark_filter=Broadphase).
+  for (uint32_t n : {10000u, 100000u}) {
+    add("BulletDbvtSettings/no-static-filter", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtNoFilter>>(s, "dbvt-no-static-filter"); });
+    add("BulletDbvtSettings/static-filter", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtStatic>>(s, "dbvt-static-filter"); });
+    add("BulletDbvtSettings/deferred-collide", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtDeferred>>(s, "dbvt-deferred"); });
+    add("BulletDbvtSettings/optimize", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtOptimize>>(s, "dbvt-optimize"); });
+    add("BulletDbvtSettings/deferred-optimize", n,
+        [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtDeferredOptimize>>(s, "dbvt-deferred-optimize"); });
+    add("BulletDbvtSettings/dupdates-1", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtDupdates>>(s, "dbvt-dupdates"); });
+    add("BulletDbvtSettings/prediction-0.5", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtPrediction>>(s, "dbvt-prediction"); });
+    add("BulletDbvtSettings/prediction-1", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtPrediction1>>(s, "dbvt-prediction-1"); });
+    add("BulletDbvtSettings/prediction-2", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtPrediction2>>(s, "dbvt-prediction-2"); });
+    add("BulletDbvtSettings/prediction-4", n, [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtPrediction4>>(s, "dbvt-prediction-4"); });
+    add("BulletDbvtSettings/deferred-prediction-0.5", n,
+        [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtDeferredPrediction05>>(s, "dbvt-deferred-prediction-0.5"); });
+    add("BulletDbvtSettings/deferred-prediction-1", n,
+        [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtDeferredPrediction1>>(s, "dbvt-deferred-prediction-1"); });
+    add("BulletDbvtSettings/deferred-prediction-2", n,
+        [](benchmark::State& s) { runBroadphase<BulletDbvt<kDbvtDeferredPrediction2>>(s, "dbvt-deferred-prediction-2"); });
+  }
   for (const char* scene : kScenes)
     for (Engine e : {kBrickworld, kBulletChunked, kBulletNaive}) {
       if (e == kBulletNaive && std::string(scene) == "city_rain") continue;
@@ -285,7 +663,8 @@ int main(int argc, char** argv) {
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
+  printBroadphaseRatios();
   printWorldRatios();
   printRenderRatios();
-  return 0;
+  return broadphaseMismatch() ? 1 : 0;
 }
