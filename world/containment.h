@@ -40,7 +40,8 @@ struct ContainmentReport {
 };
 
 /// Follows every dynamic body from frame to frame (call update() after each step; the world's
-/// bodies must not be added or removed in between). A body that was clear and that the step's
+/// bodies must not be added or removed in between). The checks run on the world's job system
+/// (the same report for any thread count). A body that was clear and that the step's
 /// broadphase never paired with a grid or terrain is clear without a query (World::
 /// nearSolidLastStep): most of a rain is in the air, and the queries were a third of a run.
 /// A clear body that moved less than kRecheckDistance since it was last checked (resting
@@ -62,7 +63,11 @@ class ContainmentTracker {
   const ContainmentReport& report() const { return report_; }
 
  private:
+  // What pass 1 of update() found for a body (pass 2 turns it into state).
+  enum class Check : uint8_t { None, FarFromSolid, InBrick, InVoxel, WentThrough, ClearOfGrids };
   World& world_;
+  std::vector<Check> checked_;
+  uint64_t staticEdits_ = 0;  // World::staticGridEdits() at the last update
   std::vector<Vec3d> lastSeen_;   // per body: centre when last checked (or found far from solid)
   std::vector<Vec3d> lastClear_;  // per body: the last centre seen outside solid
   std::vector<uint8_t> hasClear_; // per body: lastClear_ is set (not for a body that started inside)

@@ -26,6 +26,7 @@ World::World(const SceneDescription& scene, int threads, SubmissionMode submissi
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
   for (uint32_t i = 0; i < bodies_.size(); ++i)
     if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) solidBodies_.push_back(i);
+  nearSolid_.assign(bodies_.size(), 1);  // no step yet: containment checks every body
   sleep_.reset(bodies_.size());
   resolveStartsInSolid();
   if (scene_.attachments.enabled)
@@ -128,9 +129,7 @@ void World::substep(float dt, int index) {
   stats_.pairs += uint32_t(pairs_.size());
   stats_.contacts += uint32_t(solver_.contacts().size());
   for (uint32_t k = 0; k < pairs_.size(); ++k) {
-    const BodyPair& p = pairs_[k];
-    if (isSolid(p.a)) nearSolid_[p.b] = 1;
-    if (isSolid(p.b)) nearSolid_[p.a] = 1;
+    markNearSolid(k);
     if (pairReused_[k]) {
       ++stats_.pairsReused;
       continue;
@@ -138,6 +137,26 @@ void World::substep(float dt, int index) {
     stats_.boxTests += pairStats_[k].index.boxTests;
     stats_.narrowphase += pairStats_[k].bricksTested;
   }
+}
+
+// Containment's filter (World::nearSolidLastStep): a body is near solid in this substep if a
+// pair with a grid or terrain could have moved it into one. A grid pair that was collided and
+// met no brick (nor a LOD box) within the body's bounds plus its closing distance, in a substep
+// where the body had no contact at all (so nothing but gravity, already in its velocity,
+// changed its motion), is not; every other pair with a solid body is (reused, skipped, terrain).
+void World::markNearSolid(uint32_t k) {
+  const BodyPair& p = pairs_[k];
+  if (!pairContacts_[k].empty()) {
+    nearSolid_[p.a] = nearSolid_[p.b] = 1;  // touched something: any impulse may push it anywhere
+    return;
+  }
+  const bool solidA = isSolid(p.a), solidB = isSolid(p.b);
+  if (!solidA && !solidB) return;
+  const bool collided = !pairReused_[k] && canCollide(p.a, p.b) && (active(p.a) || active(p.b)) &&
+                        !bodies_.shape[p.a].isTerrain() && !bodies_.shape[p.b].isTerrain();
+  if (collided && pairStats_[k].bricksTested == 0 && pairStats_[k].lodBoxes == 0) return;
+  if (solidA) nearSolid_[p.b] = 1;
+  if (solidB) nearSolid_[p.a] = 1;
 }
 
 // After grid edits: bodies resting on an edited grid wake up (a removed brick must let them
@@ -188,6 +207,7 @@ void World::step() {
   profiler_.beginFrame(frame_);
   const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
   for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt, s);
+  boundsCurrent_ = true;
   finishDepenetration();
   {
     ProfileZone z(profiler_, "rays (stage)");
@@ -226,6 +246,9 @@ void World::setPoses(const std::vector<Vec3d>& positions, const std::vector<Quat
   }
   pairCache_.forget([](const BodyPair&) { return true; });
   if (render_) render_->checkAllBodies();
+  // Moved from outside: no step vouches for where bodies went (containment checks them all).
+  nearSolid_.assign(n, 1);
+  boundsCurrent_ = false;
 }
 
 uint64_t World::stateHash() const {

@@ -124,13 +124,24 @@ class World {
   uint32_t sleepingCount() const { return sleep_.count(); }
   /// Whether point `p` (world) is inside a brick of any grid body but `self`, or in a solid
   /// terrain voxel (containment.h).
-  InsideSolid pointInsideSolid(const Vec3d& p, uint32_t self) const;
+  /// staticGrids false leaves static grids out (the containment tracker tests them by the
+  /// path instead while they are unedited).
+  InsideSolid pointInsideSolid(const Vec3d& p, uint32_t self, bool staticGrids = true) const;
+  /// Sum of the static grids' edit counts: changes whenever one is edited.
+  uint64_t staticGridEdits() const;
   /// Whether the segment from `from` to `to` (world) crosses a static or kinematic grid or a
   /// terrain. Fills terrain chunk caches as rays do, so not while step() runs.
   bool segmentHitsStatic(const Vec3d& from, const Vec3d& to);
-  /// Whether body `body` was paired by the broadphase with a grid or terrain body (other than
-  /// itself) in any substep of the last step. A body that was not cannot be inside solid nor
-  /// have crossed a surface during that step: every substep's bounds cover its motion in it.
+  /// The same against static and kinematic grids only: reads only, safe on many threads.
+  bool segmentHitsStaticGrid(const Vec3d& from, const Vec3d& to) const;
+  /// The same against terrains only (fills their chunk caches: one thread, not during step()).
+  bool segmentHitsTerrain(const Vec3d& from, const Vec3d& to);
+  /// The world's job system, for work between steps that reads the world (containment).
+  JobSystem& jobs() { return jobs_; }
+  /// Whether body `body` came near a grid or terrain body in any substep of the last step: a
+  /// pair with one whose query met a brick within the body's reach, or any contact at all
+  /// (world.cpp, markNearSolid). A body that did not cannot be inside solid nor have crossed a
+  /// surface during that step: each substep's query covers its motion in it.
   bool nearSolidLastStep(uint32_t body) const { return nearSolid_[body] != 0; }
   /// The scene's ray load of the last frame: its rays and their closest hits (empty without one).
   const RayLoad& rayLoad() const { return rayLoad_; }
@@ -179,6 +190,9 @@ class World {
   void generateContacts(float dt);
   void terrainPairs(float dt);
   bool canCollide(uint32_t a, uint32_t b) const;
+  void markNearSolid(uint32_t pair);
+  /// Whether solid body `solid` can reach into `box` (its last broadphase bounds overlap it).
+  bool mayOverlapSolid(uint32_t solid, const WorldAabb& box) const;
   /// A grid or terrain body (what another body can be inside of).
   bool isSolid(uint32_t body) const { return bodies_.shape[body].isGrid() || bodies_.shape[body].isTerrain(); }
   /// The fastest the pair's surfaces can approach (m/s): relative speed plus both spins times radii.
@@ -216,7 +230,8 @@ class World {
   std::vector<std::unique_ptr<Terrain>> terrains_;
   std::vector<float> waterDensity_;
   BodyStore bodies_;
-  std::vector<uint8_t> nearSolid_;     // per body: paired with a grid or terrain in this step (containment's filter)
+  std::vector<uint8_t> nearSolid_;     // per body: came near a grid or terrain in this step (containment's filter)
+  bool boundsCurrent_ = false;         // bounds_ hold every body as it is now (a step ran, no setPoses since)
   std::vector<uint32_t> solidBodies_;  // grid and terrain bodies, ascending (what bodies can be inside)
   std::vector<Depenetration> depenetrating_;
   std::vector<uint8_t> ghost_;  // per body: on its way out of solid (collides with nothing)
