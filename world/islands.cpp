@@ -59,27 +59,30 @@ void Islands::build(const std::vector<SolverContact>& contacts, const std::vecto
   });
 }
 
-void Islands::groupContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion) {
-  const uint32_t n = uint32_t(motion.size());
-  // Contacts grouped by the island of their dynamic body, islands ordered by root id (CSR).
-  rootIndex_.assign(n, kInvalidIndex);
-  roots_.clear();
-  auto islandOfContact = [&](const SolverContact& c) { return find(motion[c.a] == MotionType::Dynamic ? c.a : c.b); };
-  for (const SolverContact& c : contacts) {
-    const uint32_t r = islandOfContact(c);
-    if (rootIndex_[r] == kInvalidIndex) {
-      rootIndex_[r] = 0;
-      roots_.push_back(r);
+void Islands::groupContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs,
+                            Profiler& profiler, int stage) {
+  // Contacts grouped by the island of their dynamic body, islands ordered by root id, contacts
+  // in contact order within one (CSR): a sort of (root, contact) keys, which are unique, so
+  // the grouping is the same for any thread count. After build(), every body points straight
+  // at its root.
+  const uint32_t m = uint32_t(contacts.size());
+  keys_.resize(m);
+  jobs.parallelFor(0, m, tuning::grainFor(m, tuning::kMinIslandGrain), [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "islands: keys", stage);
+    for (uint32_t k = begin; k < end; ++k) {
+      const SolverContact& c = contacts[k];
+      keys_[k] = uint64_t(parent_[motion[c.a] == MotionType::Dynamic ? c.a : c.b]) << 32 | k;
     }
+  });
+  keySorter_.sort(keys_, false, jobs, &profiler, "islands: group contacts", stage + 1);
+  ProfileZone z(profiler, "islands: ranges", stage + 5);
+  contacts_.resize(m);
+  start_.clear();
+  for (uint32_t k = 0; k < m; ++k) {
+    if (k == 0 || keys_[k] >> 32 != keys_[k - 1] >> 32) start_.push_back(k);
+    contacts_[k] = uint32_t(keys_[k]);
   }
-  std::sort(roots_.begin(), roots_.end());
-  for (uint32_t i = 0; i < roots_.size(); ++i) rootIndex_[roots_[i]] = i;
-  start_.assign(roots_.size() + 1, 0);
-  for (const SolverContact& c : contacts) ++start_[rootIndex_[islandOfContact(c)] + 1];
-  for (size_t i = 1; i < start_.size(); ++i) start_[i] += start_[i - 1];
-  contacts_.resize(contacts.size());
-  fill_.assign(start_.begin(), start_.end() - 1);
-  for (uint32_t k = 0; k < contacts.size(); ++k) contacts_[fill_[rootIndex_[islandOfContact(contacts[k])]]++] = k;
+  start_.push_back(m);
 }
 
 void IslandColouring::colour(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,

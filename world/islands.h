@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "jobs/job_system.h"
+#include "jobs/parallel_sort.h"
 #include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/solver_contact.h"
@@ -21,8 +22,10 @@ class Islands {
   /// makes the grouping a pure function of the contact list.
   void build(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs, Profiler& profiler,
              int stage);
-  /// Then the contacts grouped by island (one pass over the contacts, serial).
-  void groupContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion);
+  /// Then the contacts grouped by island: (root, contact) keys made and sorted on jobs (zones at
+  /// stage .. stage + 4), the island ranges read off in one pass (stage + 5).
+  void groupContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs,
+                     Profiler& profiler, int stage);
 
   uint32_t count() const { return uint32_t(start_.size() - 1); }
   /// Indices into the contact list of island i's contacts, in contact order.
@@ -40,7 +43,8 @@ class Islands {
   std::vector<uint32_t> parent_;           // union-find parent per body
   std::vector<uint32_t> start_{0};         // island i's contacts: contacts_[start_[i], start_[i + 1])
   std::vector<uint32_t> contacts_;
-  std::vector<uint32_t> rootIndex_, roots_, fill_;  // build() scratch, reused
+  std::vector<uint64_t> keys_;             // groupContacts(): (root << 32 | contact), sorted
+  ParallelSorter<uint64_t> keySorter_;
 };
 
 /// One large island's contacts in colours: no two contacts of a colour share a dynamic body,

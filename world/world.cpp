@@ -100,10 +100,7 @@ void World::substep(float dt, int index) {
       sleep_.wakeTouched(solver_.contacts());
     }
     islands_.build(solver_.contacts(), bodies_.motion, jobs_, profiler_, stage + 11);
-    {
-      ProfileZone z(profiler_, "islands: group contacts", stage + 13);
-      islands_.groupContacts(solver_.contacts(), bodies_.motion);
-    }
+    islands_.groupContacts(solver_.contacts(), bodies_.motion, jobs_, profiler_, stage + kContactStepsStage + 8);
     ProfileZone z(profiler_, "solve (stage)");
     solver_.loadBodies(bodies_, jobs_, profiler_, stage + kContactStepsStage + 4);
     const SolveStats solved = solver_.solve(islands_, bodies_.motion, false, scene_.settings, jobs_, profiler_, stage);

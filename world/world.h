@@ -209,15 +209,15 @@ class World {
   // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
   // solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first), sleeping's two
   // passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11: union,
-  // 12: flatten, 13: contacts grouped), the sweep and prune (kBroadphaseStage, its kStages),
-  // terrain pairs (kTerrainStage: warm, query, apply), the pair cache and the other steps
-  // between (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded,
-  // stored after the solve and after the relax, counters).
+  // 12: flatten; 13 unused), the sweep and prune (kBroadphaseStage, its kStages), terrain pairs
+  // (kTerrainStage: shapes, query, apply), the pair cache and the other steps between
+  // (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded, stored after
+  // the solve and after the relax, counters; then + 8 .. + 13 contacts grouped by island).
   // Every piece of a substep's work is in one of them: work/span sees the whole step.
   static constexpr int kBroadphaseStage = 14;
   static constexpr int kTerrainStage = kBroadphaseStage + SweepAndPrune::kStages;
   static constexpr int kContactStepsStage = kTerrainStage + 3;
-  static constexpr int kStagesPerSubstep = kContactStepsStage + 8;
+  static constexpr int kStagesPerSubstep = kContactStepsStage + 14;
 
   SceneDescription scene_;
   JobSystem jobs_;

@@ -32,7 +32,7 @@ void solveOnce(ContactSolver& solver, BodyStore& bodies, const std::vector<BodyP
   solver.prepare(bodies, pairs, contacts, flipped, settings, 1.f / 60, jobs, profiler, 0);
   Islands islands;
   islands.build(solver.contacts(), bodies.motion, jobs, profiler, 0);
-  islands.groupContacts(solver.contacts(), bodies.motion);
+  islands.groupContacts(solver.contacts(), bodies.motion, jobs, profiler, 0);
   solver.loadBodies(bodies, jobs, profiler);
   solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
   solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);

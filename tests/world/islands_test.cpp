@@ -4,6 +4,8 @@
 // Labelled `concurrency`: the links are made by compare-and-swap from several threads (TSan).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <numeric>
 
 #include "collision/core/seeded_random.h"
@@ -49,21 +51,29 @@ TEST(Islands, ParallelUnionFindEqualsSerialForAnyThreadCount) {
       if (r.below(3) == 0) contacts.push_back(contacts.back());  // pairs with several contacts
     }
     const std::vector<uint32_t> expected = referenceRoots(contacts, motion);
-    std::vector<uint32_t> groupedOne;
+    // The grouping, serially: contacts stably ordered by the root of their dynamic body.
+    std::vector<uint32_t> expectedGrouped(contacts.size());
+    for (uint32_t k = 0; k < contacts.size(); ++k) expectedGrouped[k] = k;
+    auto rootOf = [&](uint32_t k) { return expected[motion[contacts[k].a] == MotionType::Dynamic ? contacts[k].a : contacts[k].b]; };
+    std::stable_sort(expectedGrouped.begin(), expectedGrouped.end(), [&](uint32_t x, uint32_t y) { return rootOf(x) < rootOf(y); });
     for (int threads : {1, 2, 4, 16}) {
       SCOPED_TRACE("round " + std::to_string(round) + ", " + std::to_string(threads) + " threads");
       JobSystem jobs(threads);
       Profiler profiler;
       Islands islands;
       islands.build(contacts, motion, jobs, profiler, 0);
-      islands.groupContacts(contacts, motion);
+      islands.groupContacts(contacts, motion, jobs, profiler, 2);
       for (uint32_t i = 0; i < bodies; ++i) ASSERT_EQ(islands.root(i), expected[i]) << "body " << i;
       std::vector<uint32_t> grouped;
       for (uint32_t is = 0; is < islands.count(); ++is)
         for (uint32_t k : islands.contacts(is)) grouped.push_back(k);
-      ASSERT_EQ(grouped.size(), contacts.size());
-      if (threads == 1) groupedOne = grouped;
-      else EXPECT_EQ(grouped, groupedOne);
+      ASSERT_EQ(grouped, expectedGrouped);
+      for (uint32_t is = 0; is < islands.count(); ++is) {  // one island per range, none empty
+        ASSERT_FALSE(islands.contacts(is).empty());
+        const uint32_t root = rootOf(islands.contacts(is)[0]);
+        for (uint32_t k : islands.contacts(is)) ASSERT_EQ(rootOf(k), root);
+        if (is > 0) ASSERT_LT(rootOf(islands.contacts(is - 1)[0]), root);
+      }
     }
   }
 }
