@@ -158,7 +158,7 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
   // The sweep's jobs cut by cost, not by count: proxy i tests the proxies up to the first whose
   // min lies past its max (found by binary search), plus a static tree query. A landing pile
   // packs most of the tests into a few hundred proxies; equal counts left one job with a sixth
-  // of crate_pile's sweep. The cut is a pure function of the bounds (determinism).
+  // of crate_pile's sweep. The cut decides only which job finds a pair, never the pairs.
   const StaticBoundsTree& tree = *staticTree_;
   // A tree query costs what the last frame's queries cost on average (box tests weigh like
   // interval tests); the cut changes only how the work is shared, never the pairs.

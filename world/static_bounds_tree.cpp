@@ -15,7 +15,7 @@ void StaticBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::vec
   nodes_.clear();
   if (items_.empty()) return;
   nodes_.reserve(2 * (items_.size() / kLeafSize + 1));
-  nodes_.push_back({});
+  nodes_.push_back(emptyNode());
   split(0, 0, uint32_t(items_.size()));
 }
 
@@ -47,8 +47,8 @@ void StaticBoundsTree::split(uint32_t node, uint32_t begin, uint32_t end) {
   const uint32_t left = uint32_t(nodes_.size());
   nodes_[node].first = left;
   nodes_[node].count = 0;
-  nodes_.push_back({});
-  nodes_.push_back({});
+  nodes_.push_back(emptyNode());
+  nodes_.push_back(emptyNode());
   split(left, begin, mid);
   split(left + 1, mid, end);
 }

@@ -65,6 +65,8 @@ class StaticBoundsTree {
     uint32_t first;  // leaf: first item; inner: index of the left child (the right one follows)
     uint32_t count;  // items in a leaf, 0 for an inner node
   };
+  // A node for split() to fill (zeroed: Eigen leaves a default-constructed vector unset).
+  static Node emptyNode() { return {WorldAabb{Vec3d::Zero(), Vec3d::Zero()}, 0, 0}; }
   void split(uint32_t node, uint32_t begin, uint32_t end);
 
   std::vector<Item> items_;
