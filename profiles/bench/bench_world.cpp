@@ -315,45 +315,50 @@ struct DbvtSettings {
   float prediction = 0;       // setVelocityPrediction
 };
 
-struct BulletWorldParts {  // what calculateOverlappingPairs needs besides the broadphase
+// What both Bullet rows share: the dispatcher calculateOverlappingPairs needs, one proxy per
+// body (client object = index + 1), every moving proxy moved each frame, pairs read from the
+// cache through the exact box test.
+template <class Broadphase>
+struct BulletBroadphaseRow {
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher{&config};
-};
-
-template <const DbvtSettings& S>
-struct BulletDbvt {
-  BulletWorldParts parts;
-  std::unique_ptr<btDbvtBroadphase> bp;
+  std::unique_ptr<Broadphase> bp;
   std::vector<btBroadphaseProxy*> proxies;
   double cached = 0;
-  void first(const Bodies& b, std::vector<BodyPair>& pairs) {
-    bp = std::make_unique<btDbvtBroadphase>();
-    bp->m_deferedcollide = S.deferred;
-    bp->m_dupdates = S.dupdates;
-    bp->setVelocityPrediction(S.prediction);
+  void createProxies(const Bodies& b, bool staticFilter) {
     proxies.resize(b.bounds.size());
     for (uint32_t i = 0; i < b.bounds.size(); ++i) {
       int group, mask;
-      bulletFilter(b, i, S.staticFilter, group, mask);
+      bulletFilter(b, i, staticFilter, group, mask);
       proxies[i] = bp->createProxy(bt(b.bounds[i].min), bt(b.bounds[i].max), BOX_SHAPE_PROXYTYPE,
-                                   reinterpret_cast<void*>(uintptr_t(i) + 1), group, mask, &parts.dispatcher);
+                                   reinterpret_cast<void*>(uintptr_t(i) + 1), group, mask, &dispatcher);
     }
-    if (S.optimize) bp->optimize();
-    bp->calculateOverlappingPairs(&parts.dispatcher);
-    read(b, pairs);
   }
   void frame(const Bodies& b, std::vector<BodyPair>& pairs) {
     for (uint32_t i = b.grids; i < b.bounds.size(); ++i)  // the moving proxies: every one moved
-      bp->setAabb(proxies[i], bt(b.bounds[i].min), bt(b.bounds[i].max), &parts.dispatcher);
-    bp->calculateOverlappingPairs(&parts.dispatcher);
-    read(b, pairs);
+      bp->setAabb(proxies[i], bt(b.bounds[i].min), bt(b.bounds[i].max), &dispatcher);
+    findPairs(b, pairs);
   }
-  void read(const Bodies& b, std::vector<BodyPair>& pairs) {
+  void findPairs(const Bodies& b, std::vector<BodyPair>& pairs) {
+    bp->calculateOverlappingPairs(&dispatcher);
     cached = bp->getOverlappingPairCache()->getNumOverlappingPairs();
     readBulletPairs(*bp->getOverlappingPairCache(), b, pairs);
   }
   double tests() const { return kNaN; }
   double cachePairs() const { return cached; }
+};
+
+template <const DbvtSettings& S>
+struct BulletDbvt : BulletBroadphaseRow<btDbvtBroadphase> {
+  void first(const Bodies& b, std::vector<BodyPair>& pairs) {
+    bp = std::make_unique<btDbvtBroadphase>();
+    bp->m_deferedcollide = S.deferred;
+    bp->m_dupdates = S.dupdates;
+    bp->setVelocityPrediction(S.prediction);
+    createProxies(b, S.staticFilter);
+    if (S.optimize) bp->optimize();
+    findPairs(b, pairs);
+  }
 };
 
 constexpr DbvtSettings kDbvtNoFilter{.staticFilter = false};
@@ -374,11 +379,7 @@ constexpr const DbvtSettings& kDbvtChosen = kDbvtPrediction2;
 // bt32BitAxisSweep3: Bullet's incremental sweep and prune (32-bit quantized edges, so it holds
 // far more than 1M handles), the world box 50 m around the scene, no raycast accelerator (it
 // would mirror every proxy into a second, dbvt, broadphase; nothing here casts rays).
-struct BulletAxisSweep {
-  BulletWorldParts parts;
-  std::unique_ptr<bt32BitAxisSweep3> bp;
-  std::vector<btBroadphaseProxy*> proxies;
-  double cached = 0;
+struct BulletAxisSweep : BulletBroadphaseRow<bt32BitAxisSweep3> {
   void first(const Bodies& b, std::vector<BodyPair>& pairs) {
     Vec3d lo = b.bounds[0].min, hi = b.bounds[0].max;
     for (const WorldAabb& w : b.bounds) {
@@ -387,28 +388,9 @@ struct BulletAxisSweep {
     }
     bp = std::make_unique<bt32BitAxisSweep3>(bt(lo - Vec3d::Constant(50)), bt(hi + Vec3d::Constant(50)),
                                              unsigned(b.bounds.size() + 1), nullptr, true);
-    proxies.resize(b.bounds.size());
-    for (uint32_t i = 0; i < b.bounds.size(); ++i) {
-      int group, mask;
-      bulletFilter(b, i, true, group, mask);
-      proxies[i] = bp->createProxy(bt(b.bounds[i].min), bt(b.bounds[i].max), BOX_SHAPE_PROXYTYPE,
-                                   reinterpret_cast<void*>(uintptr_t(i) + 1), group, mask, &parts.dispatcher);
-    }
-    bp->calculateOverlappingPairs(&parts.dispatcher);
-    read(b, pairs);
+    createProxies(b, true);
+    findPairs(b, pairs);
   }
-  void frame(const Bodies& b, std::vector<BodyPair>& pairs) {
-    for (uint32_t i = b.grids; i < b.bounds.size(); ++i)
-      bp->setAabb(proxies[i], bt(b.bounds[i].min), bt(b.bounds[i].max), &parts.dispatcher);
-    bp->calculateOverlappingPairs(&parts.dispatcher);
-    read(b, pairs);
-  }
-  void read(const Bodies& b, std::vector<BodyPair>& pairs) {
-    cached = bp->getOverlappingPairCache()->getNumOverlappingPairs();
-    readBulletPairs(*bp->getOverlappingPairCache(), b, pairs);
-  }
-  double tests() const { return kNaN; }
-  double cachePairs() const { return cached; }
 };
 
 // Our OctoBVH over all bodies (statics filter 2, moving 1): built in bulk, then every frame
