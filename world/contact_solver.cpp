@@ -279,30 +279,50 @@ void ContactSolver::solveIsland(std::span<const uint32_t> island, bool relax, co
   }
 }
 
+namespace {
+
+// A profiling stage of its own for each wave of a coloured island: the colours run one after
+// another, so work/span must add their spans, not fold them into the stage of the parallel
+// islands. Distinct from every world stage (those stay below kWaveStageBase) within a frame.
+constexpr int32_t kWaveStageBase = 1 << 20;
+constexpr uint32_t kWavesPerStage = 1 << 16;
+int32_t waveStage(int stage, uint32_t& wave) { return kWaveStageBase + stage * int32_t(kWavesPerStage) + int32_t(wave++ % kWavesPerStage); }
+
+}  // namespace
+
 // One big island (a pile) on every thread: colour by colour, each colour's contacts in parallel.
 // Iterations alternate the colour order like solveIsland alternates the contact order.
 void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, const std::vector<MotionType>& motion, bool relax,
-                                         const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage) {
-  colouring_.colour(island, contacts_, motion);
-  const uint32_t colours = colouring_.colours();
-  if (!relax)
-    for (uint32_t c : colouring_.all()) warmStart(contacts_[c]);
+                                         const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage,
+                                         uint32_t& wave) {
+  const char* const name = relax ? "relax: colour" : "colour";
+  uint32_t colours = 0;
+  {
+    ProfileZone zone(profiler, relax ? "relax: colouring" : "colouring", waveStage(stage, wave), true);
+    colouring_.colour(island, contacts_, motion);
+    colours = colouring_.colours();
+    if (!relax)
+      for (uint32_t c : colouring_.all()) warmStart(contacts_[c]);
+  }
   const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
   for (int it = 0; it < iterations; ++it) {
     for (uint32_t i = 0; i < colours; ++i) {
       const uint32_t c = (it & 1) ? colours - 1 - i : i;
       const std::span<const uint32_t> group = colouring_.colour(c);
+      const int32_t waveId = waveStage(stage, wave);
       if (c == kMaxColours) {  // the serial group: contacts may share bodies
+        ProfileZone zone(profiler, name, waveId, true);
         for (uint32_t k : group) solveContact(contacts_[k], relax);
         continue;
       }
       jobs.parallelFor(0, uint32_t(group.size()), kColourGrain, [&](uint32_t cb, uint32_t ce) {
-        ProfileZone zone(profiler, "colour", stage + (relax ? 5 : 3));
+        ProfileZone zone(profiler, name, waveId);
         for (uint32_t j = cb; j < ce; ++j) solveContact(contacts_[group[j]], relax);
       });
     }
   }
   if (!relax && settings.shockPropagation) {  // one serial sweep over the whole pile
+    ProfileZone zone(profiler, "shock sweep", waveStage(stage, wave), true);
     std::vector<uint32_t> list(colouring_.all().begin(), colouring_.all().end());
     shockSweep(list);
   }
@@ -316,11 +336,12 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
   // on their size, so the result does not depend on the thread count.
   SolveStats stats;
   smallIslands_.clear();
+  uint32_t wave = 0;
   for (uint32_t i = 0; i < islands.count(); ++i) {
     const uint32_t size = uint32_t(islands.contacts(i).size());
     stats.largestIsland = std::max(stats.largestIsland, size);
     if (size > kSplitContacts) {
-      solveIslandInColours(islands.contacts(i), motion, relax, settings, jobs, profiler, stage);
+      solveIslandInColours(islands.contacts(i), motion, relax, settings, jobs, profiler, stage + (relax ? 5 : 3), wave);
       ++stats.splitIslands;
     } else {
       smallIslands_.push_back(i);

@@ -66,8 +66,10 @@ class ContactSolver {
   void solveContactShock(SolverContact& s);
   void shockSweep(std::vector<uint32_t>& contacts);
   void solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings);
+  // `wave` numbers the island's waves (colours and serial steps, each a dependent step of
+  // the solve) across the islands of one solve, for their profiling stages.
   void solveIslandInColours(std::span<const uint32_t> island, const std::vector<MotionType>& motion, bool relax,
-                            const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage);
+                            const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave);
 
   std::vector<SolverContact> contacts_;
   std::vector<SolverBody> bodies_;

@@ -1,14 +1,18 @@
 // Pairs with a terrain: solid contacts against the chunk triangles, then buoyancy and water
-// drag from the water voxels the body displaces. In three stages:
-//   shapes (one thread, pair order): each pair's shape and pose (a grid's hull is made lazily);
-//   query  (parallel, per pair): contacts from chunks already in the terrain's cache
-//          (terrainContactsCached only reads) and the water estimate, each into its own slot;
-//   apply  (one thread, pair order): a pair that needed a chunk not yet meshed is queried the
+// drag from the water voxels the body displaces. In six stages:
+//   select (one thread, pair order): the terrain pairs; a grid's hull is made here (lazily);
+//   plan   (parallel, per query): the shape, its pose and margin, the candidate triangles from
+//          chunks already in the terrain's cache (TerrainContactPlan only reads), the water;
+//   cut    (one thread): each query's candidates cut into pieces;
+//   pieces (parallel, per piece): the contacts of a few candidate triangles each, so a body
+//          lying across many triangles is spread over several jobs;
+//   finish (parallel, per query): the pieces' contacts joined in order, interior edges and
+//          repeated points dropped; buoyancy when no body has two terrain queries;
+//   apply  (one thread, pair order): a query that needed a chunk not yet meshed runs again the
 //          filling way (the meshes stay lazy: only chunks a body touches are ever built, and
-//          in steady state every chunk is cached); buoyancy and drag change the body's velocity
-//          in pair order, as before.
-// The contacts are the same whichever stage computes them, so the state is the same for any
-// thread count and any cache budget.
+//          in steady state every chunk is cached); counters; buoyancy otherwise.
+// The contacts are the same whichever stage computes them (the pieces join in the serial
+// query's order), so the state is the same for any thread count and any cache budget.
 // note: the parallel reads do not refresh the cache's LRU order; a scene whose touched chunks
 // exceed the cache budget re-meshes more than with serial queries (the default budget holds
 // every shipped scene's chunks).
@@ -22,54 +26,91 @@ namespace bw {
 
 using namespace tuning;
 
+namespace {
+
+uint32_t trianglesPerPiece(const QueryShape& s) {
+  const bool convex = s.kind == QueryShape::Kind::Box || s.kind == QueryShape::Kind::Hull;
+  return convex ? kConvexTrianglesPerPiece : kRoundTrianglesPerPiece;
+}
+
+}  // namespace
+
 void World::terrainPairs(float dt) {
   if (terrains_.empty()) return;
+  TerrainPairWork& w = terrainWork_;
   const uint32_t n = uint32_t(pairs_.size());
   const Vec3f g = scene_.settings.gravity.cast<float>();
   stats_.floating = 0;  // bodies in water in the last substep
-  terrainQueries_.clear();
+  w.queries.clear();
+  w.bodiesUnique = true;
   {
-    ProfileZone z(profiler_, "terrain: shapes", stage_ + kTerrainStage);
+    ProfileZone z(profiler_, "terrain: select", stage_ + kTerrainStage);
+    w.bodyQueried.resize(bodies_.size(), 0);
     for (uint32_t k = 0; k < n; ++k) {
       const uint32_t a = pairs_[k].a, b = pairs_[k].b;
       const bool terrainA = bodies_.shape[a].isTerrain();
       if (!terrainA && !bodies_.shape[b].isTerrain()) continue;
       if (!canCollide(a, b) || (!active(a) && !active(b))) continue;
-      TerrainQuery q;
+      TerrainPairWork::Query q;
       q.pair = k;
       q.body = terrainA ? b : a;
       q.terrain = bodies_.shape[terrainA ? a : b].terrain;
+      // A grid meets terrain through its convex approximation (as it meets other grids), made
+      // here, on one thread, the first time it is needed.
+      if (bodies_.shape[q.body].isGrid()) grids_[bodies_.shape[q.body].grid]->convexApproximation(scene_.settings.approximationDepth);
+      pairFlipped_[k] = q.body == b;  // normals point from the terrain towards the body
+      w.bodiesUnique &= w.bodyQueried[q.body] == 0;
+      w.bodyQueried[q.body] = 1;
+      w.queries.push_back(q);
+    }
+    for (const TerrainPairWork::Query& q : w.queries) w.bodyQueried[q.body] = 0;
+  }
+  const uint32_t m = uint32_t(w.queries.size());
+  if (w.plans.size() < m) w.plans.resize(m);
+  jobs_.parallelFor(0, m, grainFor(m, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler_, "terrain: plan", stage_ + kTerrainStage + 1);
+    for (uint32_t i = begin; i < end; ++i) {
+      TerrainPairWork::Query& q = w.queries[i];
+      const BodyPair& p = pairs_[q.pair];
       q.pose = bodies_.shapePose(q.body);
       q.shape = bodies_.shape[q.body].primitive;
       if (bodies_.shape[q.body].isGrid()) {
-        // A grid meets terrain through its convex approximation (as it meets other grids).
         const ConvexApproximation& hull = grids_[bodies_.shape[q.body].grid]->convexApproximation(scene_.settings.approximationDepth);
         q.pose.translation = q.pose.pointToWorld(hull.shapeCenter());
         q.shape = hull.shape();
       }
-      q.margin = tuning::kSpeculativeMargin + closingSpeed(q.body, terrainA ? a : b) * dt;
-      pairFlipped_[k] = q.body == b;  // normals point from the terrain towards the body
-      terrainQueries_.push_back(q);
-    }
-  }
-  const uint32_t m = uint32_t(terrainQueries_.size());
-  jobs_.parallelFor(0, m, grainFor(m, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
-    ProfileZone z(profiler_, "terrain pairs", stage_ + kTerrainStage + 1);
-    for (uint32_t i = begin; i < end; ++i) {
-      TerrainQuery& q = terrainQueries_[i];
+      q.margin = tuning::kSpeculativeMargin + closingSpeed(q.body, q.body == p.a ? p.b : p.a) * dt;
       const Terrain& terrain = *terrains_[q.terrain];
-      std::vector<Contact>& out = pairContacts_[q.pair];
-      out.clear();
-      q.cached = terrainContactsCached(terrain, q.shape, q.pose, q.margin, out);
+      q.cached = w.plans[i].plan(terrain, q.shape, q.pose, q.margin);
       q.wet = bodies_.motion[q.body] == MotionType::Dynamic && terrainWaterContact(terrain, q.shape, q.pose, q.water);
     }
   });
-  ProfileZone z(profiler_, "terrain: apply", stage_ + kTerrainStage + 2);
-  for (const TerrainQuery& q : terrainQueries_) {
-    std::vector<Contact>& out = pairContacts_[q.pair];
-    if (!q.cached) terrainContacts(*terrains_[q.terrain], q.shape, q.pose, q.margin, out);
-    stats_.terrainContacts += uint32_t(out.size());
-    if (!q.wet) continue;
+  {
+    // Cut each planned query's candidates into pieces (a few microseconds of work each).
+    ProfileZone z(profiler_, "terrain: cut", stage_ + kTerrainStage + 2);
+    w.pieces.clear();
+    for (uint32_t i = 0; i < m; ++i) {
+      TerrainPairWork::Query& q = w.queries[i];
+      q.firstPiece = uint32_t(w.pieces.size());
+      const uint32_t count = q.cached ? w.plans[i].triangleCount() : 0;
+      const uint32_t per = trianglesPerPiece(q.shape);
+      for (uint32_t t = 0; t < count; t += per) w.pieces.push_back({i, t, std::min(count, t + per)});
+      q.pieceCount = uint32_t(w.pieces.size()) - q.firstPiece;
+    }
+  }
+  const uint32_t pieceCount = uint32_t(w.pieces.size());
+  if (w.pieceOutputs.size() < pieceCount) w.pieceOutputs.resize(pieceCount);
+  jobs_.parallelFor(0, pieceCount, grainFor(pieceCount, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler_, "terrain pairs", stage_ + kTerrainStage + 3);
+    for (uint32_t i = begin; i < end; ++i) {
+      const TerrainPairWork::Piece& piece = w.pieces[i];
+      TerrainPairWork::PieceOutput& o = w.pieceOutputs[i];
+      o.contacts.clear();
+      o.faceNormals.clear();
+      w.plans[piece.query].contactsOfTriangles(piece.begin, piece.end, o.contacts, o.faceNormals);
+    }
+  });
+  const auto buoyancy = [&](const TerrainPairWork::Query& q) {
     // Archimedes: the displaced water's weight, applied at the centre of buoyancy, as an
     // impulse this substep; then drag in proportion to how deep the body sits.
     const uint32_t body = q.body;
@@ -84,6 +125,32 @@ void World::terrainPairs(float dt) {
     const float f = q.water.submergedFraction;
     bodies_.linearVelocity[body] *= std::max(0.f, 1.f - kWaterLinearDrag * f * dt);
     bodies_.angularVelocity[body] *= std::max(0.f, 1.f - kWaterAngularDrag * f * dt);
+  };
+  jobs_.parallelFor(0, m, grainFor(m, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler_, "terrain: finish", stage_ + kTerrainStage + 4);
+    // note: thread_local scratch: the face normals of one query, joined from its pieces.
+    thread_local std::vector<Vec3f> faceNormals;
+    for (uint32_t i = begin; i < end; ++i) {
+      const TerrainPairWork::Query& q = w.queries[i];
+      std::vector<Contact>& out = pairContacts_[q.pair];
+      out.clear();
+      faceNormals.clear();
+      for (uint32_t p = q.firstPiece; p < q.firstPiece + q.pieceCount; ++p) {
+        const TerrainPairWork::PieceOutput& o = w.pieceOutputs[p];
+        out.insert(out.end(), o.contacts.begin(), o.contacts.end());
+        faceNormals.insert(faceNormals.end(), o.faceNormals.begin(), o.faceNormals.end());
+      }
+      finishTerrainContacts(out, 0, faceNormals);
+      if (w.bodiesUnique && q.wet) buoyancy(q);
+    }
+  });
+  ProfileZone z(profiler_, "terrain: apply", stage_ + kTerrainStage + 5);
+  for (const TerrainPairWork::Query& q : w.queries) {
+    std::vector<Contact>& out = pairContacts_[q.pair];
+    if (!q.cached) terrainContacts(*terrains_[q.terrain], q.shape, q.pose, q.margin, out);
+    stats_.terrainContacts += uint32_t(out.size());
+    if (!q.wet) continue;
+    if (!w.bodiesUnique) buoyancy(q);
     ++stats_.floating;
   }
 }

@@ -40,6 +40,7 @@
 #include "world/ray_load.h"
 #include "world/scene_description.h"
 #include "world/sleeping.h"
+#include "world/terrain_pair_work.h"
 #include "world/world_render.h"
 
 namespace bw {
@@ -210,13 +211,13 @@ class World {
   // solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first), sleeping's two
   // passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11: union,
   // 12: flatten; 13 unused), the sweep and prune (kBroadphaseStage, its kStages), terrain pairs
-  // (kTerrainStage: shapes, query, apply), the pair cache and the other steps between
+  // (kTerrainStage: select, plan, cut, pieces, finish, apply), the pair cache and the other steps between
   // (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded, stored after
   // the solve and after the relax, counters; then + 8 .. + 13 contacts grouped by island).
   // Every piece of a substep's work is in one of them: work/span sees the whole step.
   static constexpr int kBroadphaseStage = 14;
   static constexpr int kTerrainStage = kBroadphaseStage + SweepAndPrune::kStages;
-  static constexpr int kContactStepsStage = kTerrainStage + 3;
+  static constexpr int kContactStepsStage = kTerrainStage + 6;
   static constexpr int kStagesPerSubstep = kContactStepsStage + 14;
 
   SceneDescription scene_;
@@ -260,16 +261,7 @@ class World {
   std::vector<uint8_t> pairReused_;                 // slot's contacts came from the pair cache
   std::vector<ContactStats> pairStats_;
   // One per pair with a terrain this substep (terrain_pairs.cpp).
-  struct TerrainQuery {
-    uint32_t pair, body, terrain;
-    RigidTransform pose;  // the body's shape (or its grid's hull) in the world
-    QueryShape shape;
-    float margin;
-    bool cached = false;  // contacts found from cached chunks (else queried again in pair order)
-    bool wet = false;
-    WaterContact water;
-  };
-  std::vector<TerrainQuery> terrainQueries_;
+  TerrainPairWork terrainWork_;
   PairCache pairCache_;
   ContactSolver solver_;
   Islands islands_;

@@ -78,9 +78,12 @@ inline constexpr uint32_t kMaxColours = 64;
 inline constexpr uint32_t kColourGrain = 64;
 /// Pairs per job in contact generation (a pair may be a grid query of many bricks).
 inline constexpr uint32_t kPairGrain = 4;
-/// Fewest pairs per job of the terrain queries: one (a query meets a few chunks' triangles, tens
-/// of microseconds for a body lying in a pile of them).
+/// Fewest items per job of the terrain stages: one (a query's plan or a piece of its triangles).
 inline constexpr uint32_t kMinTerrainGrain = 1;
+/// Candidate triangles per piece of one terrain query (TerrainPairWork): a box or hull tests each
+/// by GJK (and EPA when it touches, a few microseconds), a sphere or capsule in closed form.
+inline constexpr uint32_t kConvexTrianglesPerPiece = 4;
+inline constexpr uint32_t kRoundTrianglesPerPiece = 32;
 /// Rays per job in the scene's ray load.
 inline constexpr uint32_t kRayGrain = 64;
 

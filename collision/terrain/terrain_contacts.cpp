@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "collision/core/argument_checks.h"
@@ -165,93 +166,170 @@ void forEachQueriedChunk(const Terrain& terrain, const QueryShape& shape, const 
   });
 }
 
-// The contacts, with chunk data from lookup(chunk) (nullptr: not available, the query stops
-// and returns false with `out` as it was).
-template <class Lookup>
-bool contactsWith(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec, std::vector<Contact>& out,
-                  Lookup&& lookup) {
+}  // namespace
+
+// Bullet's view of a box or hull query shape, kept by a plan so a steady-state query allocates
+// nothing (a hull's point array keeps its capacity). GJK only reads the shapes, so the pieces of
+// one plan share them across threads.
+struct TerrainContactPlan::BulletShapes {
+  // Made the way a fresh shape per query was (margin 0 set after the points' bounds), so the
+  // contacts stay bit-identical.
+  struct Hull : btConvexHullShape {
+    void setPoints(const Vec3f* points, uint32_t count) {
+      setMargin(CONVEX_DISTANCE_MARGIN);
+      m_unscaledPoints.resize(0);
+      for (uint32_t i = 0; i < count; ++i) m_unscaledPoints.push_back(toBt(points[i]));
+      recalcLocalAabb();
+      setMargin(0.f);
+    }
+  };
+  std::optional<btBoxShape> box;
+  Hull hull;
+};
+
+TerrainContactPlan::TerrainContactPlan() : bullet_(std::make_unique<BulletShapes>()) {}
+TerrainContactPlan::~TerrainContactPlan() = default;
+TerrainContactPlan::TerrainContactPlan(TerrainContactPlan&&) noexcept = default;
+TerrainContactPlan& TerrainContactPlan::operator=(TerrainContactPlan&&) noexcept = default;
+
+// The candidate triangles, with chunk data from lookup(chunk) (nullptr: not available; the
+// plan is then empty and this returns false). After each chunk, chunkDone(first, end) gets the
+// range of its triangles, before the next lookup (which may evict that chunk when it fills the cache).
+template <class Lookup, class ChunkDone>
+bool planWith(TerrainContactPlan& p, const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec,
+              Lookup&& lookup, ChunkDone&& chunkDone) {
   const char* const where = "terrainContacts";
   validatePlacedShape(shape, pose, where);
   requireInRange(spec, 0.0, 1e6, where, "speculativeDistance");
-  const size_t before = out.size();
-  // Face normal (world) of the triangle behind each contact appended by this call.
-  // note: thread_local scratch, so steady-state queries do not allocate, on any thread.
-  thread_local std::vector<Vec3f> faceNormals;
-  faceNormals.clear();
-
-  // Bullet shapes are made once per query; only the triangle changes per pair.
-  btBoxShape btBox(toBt(shape.halfExtents.cwiseMax(Vec3f::Constant(1e-6f))));
-  btBox.setMargin(0.f);
-  btConvexHullShape btHull;
-  if (shape.kind == QueryShape::Kind::Hull) {
-    for (uint32_t i = 0; i < shape.pointCount; ++i) btHull.addPoint(toBt(shape.points[i]), false);
-    btHull.recalcLocalAabb();
-    btHull.setMargin(0.f);
+  p.terrain_ = &terrain;
+  p.shape_ = shape;
+  p.pose_ = pose;
+  p.spec_ = spec;
+  p.triangles_.clear();
+  if (shape.kind == QueryShape::Kind::Box) {
+    p.bullet_->box.emplace(toBt(shape.halfExtents.cwiseMax(Vec3f::Constant(1e-6f))));
+    p.bullet_->box->setMargin(0.f);
+  } else if (shape.kind == QueryShape::Kind::Hull) {
+    p.bullet_->hull.setPoints(shape.points, shape.pointCount);
   }
-
   bool complete = true;
   forEachQueriedChunk(terrain, shape, pose, spec, [&](const Int3& chunk) {
     const ChunkCollision* found = lookup(chunk);
     if (!found) return complete = false;
-    const ChunkCollision& cc = *found;
-    if (cc.mesh.triangleCount() == 0) return true;
+    if (found->mesh.triangleCount() == 0) return true;
     const RigidTransform xf = terrain.chunkTransform(chunk);
-    const Quatf localRot = xf.rotationToLocal(pose.rotation);
-    const LocalShape ls = placeShape(shape, xf.pointToLocal(pose.translation), localRot);
+    const LocalShape ls = placeShape(shape, xf.pointToLocal(pose.translation), xf.rotationToLocal(pose.rotation));
     const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds).expanded(spec);
-    btTransform btXf(btQuaternion(localRot.x(), localRot.y(), localRot.z(), localRot.w()), toBt(ls.centre));
-    const TriangleMeshView mesh = cc.mesh.view();
-    cc.tree.queryAabb(mesh, box, [&](uint32_t t) {
-      Vec3f a, b, c;
-      mesh.corners(t, a, b, c);
-      const Vec3f cr = (b - a).cross(c - a);
-      const float len = cr.norm();
-      if (!(len > 0.f)) return;
-      const Vec3f n = cr / len;
-      LocalContact lc[8];
-      int k = 0;
-      switch (shape.kind) {
-        case QueryShape::Kind::Sphere:
-          k = sphereTriangle(ls.centre, shape.radius, a, b, c, n, spec, lc[0]) ? 1 : 0;
-          break;
-        case QueryShape::Kind::Capsule: {
-          const Vec3f axis = ls.rot.col(2) * shape.halfHeight;
-          LocalContact two[2];
-          k = capsuleTriangle(ls.centre - axis, ls.centre + axis, shape.radius, a, b, c, n, spec, two);
-          std::copy(two, two + k, lc);
-          break;
-        }
-        case QueryShape::Kind::Box:
-          k = convexTriangle(btBox, btXf, ls, a, b, c, n, spec, lc, 8);
-          break;
-        case QueryShape::Kind::Hull:
-          k = convexTriangle(btHull, btXf, ls, a, b, c, n, spec, lc, 8);
-          break;
-      }
-      for (int i = 0; i < k; ++i) {
-        out.push_back({xf.pointToWorld(lc[i].point), xf.directionToWorld(lc[i].normal), lc[i].depth, featureOf(chunk, t),
-                       cc.mesh.materials[t]});
-        faceNormals.push_back(xf.directionToWorld(n));
-      }
-    });
+    const uint32_t first = uint32_t(p.triangles_.size());
+    found->tree.queryAabb(found->mesh.view(), box, [&](uint32_t t) { p.triangles_.push_back({found, chunk, t}); });
+    chunkDone(first, uint32_t(p.triangles_.size()));
     return true;
   });
-  if (!complete) {
-    out.resize(before);
-    return false;
+  if (!complete) p.triangles_.clear();
+  return complete;
+}
+
+bool TerrainContactPlan::plan(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec) {
+  return planWith(
+      *this, terrain, shape, pose, spec, [&](const Int3& chunk) { return terrain.cachedChunkCollision(chunk); },
+      [](uint32_t, uint32_t) {});
+}
+
+void TerrainContactPlan::contactsOfTriangles(uint32_t begin, uint32_t end, std::vector<Contact>& out,
+                                             std::vector<Vec3f>& faceNormals) const {
+  if (begin > end || end > triangles_.size()) {
+    throw InvalidInput("TerrainContactPlan::contactsOfTriangles: range [" + std::to_string(begin) + ", " + std::to_string(end) +
+                       ") outside the plan's " + std::to_string(triangles_.size()) + " triangles");
   }
-  dropInteriorEdgeContacts(out, before, faceNormals);
+  const QueryShape& shape = shape_;
+  const btConvexShape* convex = nullptr;
+  if (shape.kind == QueryShape::Kind::Box) convex = &*bullet_->box;
+  if (shape.kind == QueryShape::Kind::Hull) convex = &bullet_->hull;
+  // The shape in the frame of the chunk at hand, placed again when the chunk changes.
+  const ChunkCollision* placedIn = nullptr;
+  Int3 placedAt{};
+  RigidTransform xf;
+  LocalShape ls{};
+  btTransform btXf;
+  for (uint32_t i = begin; i < end; ++i) {
+    const Triangle& tr = triangles_[i];
+    if (tr.chunk != placedIn || tr.coords != placedAt) {
+      placedIn = tr.chunk;
+      placedAt = tr.coords;
+      xf = terrain_->chunkTransform(tr.coords);
+      const Quatf localRot = xf.rotationToLocal(pose_.rotation);
+      ls = placeShape(shape, xf.pointToLocal(pose_.translation), localRot);
+      btXf = btTransform(btQuaternion(localRot.x(), localRot.y(), localRot.z(), localRot.w()), toBt(ls.centre));
+    }
+    const TriangleMeshView mesh = tr.chunk->mesh.view();
+    const uint32_t t = tr.triangle;
+    Vec3f a, b, c;
+    mesh.corners(t, a, b, c);
+    const Vec3f cr = (b - a).cross(c - a);
+    const float len = cr.norm();
+    if (!(len > 0.f)) continue;
+    const Vec3f n = cr / len;
+    LocalContact lc[8];
+    int k = 0;
+    switch (shape.kind) {
+      case QueryShape::Kind::Sphere:
+        k = sphereTriangle(ls.centre, shape.radius, a, b, c, n, spec_, lc[0]) ? 1 : 0;
+        break;
+      case QueryShape::Kind::Capsule: {
+        const Vec3f axis = ls.rot.col(2) * shape.halfHeight;
+        LocalContact two[2];
+        k = capsuleTriangle(ls.centre - axis, ls.centre + axis, shape.radius, a, b, c, n, spec_, two);
+        std::copy(two, two + k, lc);
+        break;
+      }
+      case QueryShape::Kind::Box:
+      case QueryShape::Kind::Hull:
+        k = convexTriangle(*convex, btXf, ls, a, b, c, n, spec_, lc, 8);
+        break;
+    }
+    for (int j = 0; j < k; ++j) {
+      out.push_back({xf.pointToWorld(lc[j].point), xf.directionToWorld(lc[j].normal), lc[j].depth, featureOf(tr.coords, t),
+                     tr.chunk->mesh.materials[t]});
+      faceNormals.push_back(xf.directionToWorld(n));
+    }
+  }
+}
+
+void finishTerrainContacts(std::vector<Contact>& out, size_t begin, const std::vector<Vec3f>& faceNormals) {
+  dropInteriorEdgeContacts(out, begin, faceNormals);
   // A point shared by several triangles (quad diagonals, corners) is reported by each: keep
   // one. Done after the interior-edge filter, which needs every triangle's face normal.
-  size_t w = before;
-  for (size_t i = before; i < out.size(); ++i) {
+  size_t w = begin;
+  for (size_t i = begin; i < out.size(); ++i) {
     bool duplicate = false;
-    for (size_t j = before; j < w && !duplicate; ++j) {
+    for (size_t j = begin; j < w && !duplicate; ++j) {
       duplicate = (out[j].position - out[i].position).squaredNorm() < 1e-10 && out[j].normal.dot(out[i].normal) > 0.9999f;
     }
     if (!duplicate) out[w++] = out[i];
   }
   out.resize(w);
+}
+
+namespace {
+
+// One whole query on the calling thread: each chunk's triangles as soon as it is looked up
+// (a filling lookup may evict chunks looked up before), then finish.
+// note: thread_local plan and scratch, so steady-state queries do not allocate, on any thread.
+template <class Lookup>
+bool contactsWith(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec, std::vector<Contact>& out,
+                  Lookup&& lookup) {
+  thread_local TerrainContactPlan plan;
+  thread_local std::vector<Vec3f> faceNormals;
+  const size_t before = out.size();
+  faceNormals.clear();
+  const bool complete = planWith(plan, terrain, shape, pose, spec, lookup, [&](uint32_t first, uint32_t end) {
+    plan.contactsOfTriangles(first, end, out, faceNormals);
+  });
+  if (!complete) {
+    out.resize(before);
+    return false;
+  }
+  finishTerrainContacts(out, before, faceNormals);
   return true;
 }
 

@@ -20,6 +20,7 @@
 /// Thread safety: terrainContacts as Terrain (it fills the cache), one thread at a time;
 /// terrainContactsCached and terrainWaterContact only read.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "collision/bricks/contact.h"
@@ -43,6 +44,63 @@ size_t terrainContacts(Terrain& terrain, const QueryShape& shape, const RigidTra
 /// refresh the cache's LRU order.
 bool terrainContactsCached(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float speculativeDistance,
                            std::vector<Contact>& out);
+
+/// One terrain contact query cut into pieces that can run on different threads: a box lying
+/// across many triangles costs as much as dozens of small queries, and would otherwise be one
+/// job that the rest of the step waits for.
+///
+///   TerrainContactPlan plan;                              // reuse across frames
+///   if (plan.plan(terrain, shape, pose, spec)) {          // candidate triangles, cached chunks only
+///     plan.contactsOfTriangles(0, k, outA, normalsA);     // any split of [0, triangleCount()),
+///     plan.contactsOfTriangles(k, n, outB, normalsB);     //   on any threads
+///     // concatenate outA, outB (and normalsA, normalsB) in order, then:
+///     finishTerrainContacts(out, before, normals);        // equals terrainContactsCached's
+///   }
+///
+/// Thread safety: plan() only reads the terrain (like terrainContactsCached); once planned,
+/// contactsOfTriangles is const and may run on several threads at once, while nothing edits
+/// the terrain or fills its cache (it keeps pointers to cached chunk data).
+class TerrainContactPlan {
+ public:
+  TerrainContactPlan();
+  ~TerrainContactPlan();
+  TerrainContactPlan(TerrainContactPlan&&) noexcept;
+  TerrainContactPlan& operator=(TerrainContactPlan&&) noexcept;
+
+  /// Gathers the triangles a query of `shape` at `pose` within `speculativeDistance` tests, in
+  /// terrainContacts' order, from chunks already cached. Returns false (and plans nothing) if a
+  /// chunk it needs is not cached. Throws InvalidInput as terrainContacts does.
+  bool plan(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float speculativeDistance);
+  /// Candidate triangles of the last successful plan.
+  uint32_t triangleCount() const { return uint32_t(triangles_.size()); }
+  /// Appends the contacts of candidate triangles [begin, end) to `out`, and the world face
+  /// normal of each one's triangle to `faceNormals`.
+  void contactsOfTriangles(uint32_t begin, uint32_t end, std::vector<Contact>& out, std::vector<Vec3f>& faceNormals) const;
+
+  struct Triangle {
+    const ChunkCollision* chunk;
+    Int3 coords;
+    uint32_t triangle;
+  };
+
+ private:
+  struct BulletShapes;
+  template <class Lookup, class ChunkDone>
+  friend bool planWith(TerrainContactPlan&, const Terrain&, const QueryShape&, const RigidTransform&, float, Lookup&&,
+                       ChunkDone&&);
+
+  const Terrain* terrain_ = nullptr;
+  QueryShape shape_;
+  RigidTransform pose_;
+  float spec_ = 0.f;
+  std::vector<Triangle> triangles_;
+  std::unique_ptr<BulletShapes> bullet_;  // the box or hull as Bullet's GJK takes it, reused
+};
+
+/// The last step of every contact query: drops interior-edge contacts (dropInteriorEdgeContacts)
+/// from out[begin, end), then keeps one of each point reported by several triangles (quad
+/// diagonals, corners) with the same normal.
+void finishTerrainContacts(std::vector<Contact>& out, size_t begin, const std::vector<Vec3f>& faceNormals);
 
 /// Interior edges: a shape resting on a flat area made of many triangles touches the
 /// neighbours of its supporting triangle at their shared (quad diagonal or quad border) edges,

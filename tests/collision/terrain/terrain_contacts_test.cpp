@@ -264,5 +264,79 @@ TEST(TerrainContacts, RejectsInvalidShapes) {
   EXPECT_THROW(terrainContacts(terrain, sphereAt(Vec3d(0, 0, 0), 1.f), NAN, contacts), InvalidInput);
 }
 
+// The world spreads one query's candidate triangles over several jobs; whatever the cut, the
+// joined pieces must give exactly the contacts of the whole query (the state hash depends on it).
+TEST(TerrainContactPlan, PiecesOnAnyCutEqualTheWholeQuery) {
+  const RigidTransform place{Vec3d(2.0e6, -3.0e5, 7.0e6), Quatf(Eigen::AngleAxisf(0.3f, Vec3f(0.2f, 1, 0.4f).normalized()))};
+  Terrain terrain({48, 24, 48}, 0.5f, place);
+  terrain.edit({0, 0, 0}, {47, 23, 47}, [](VoxelTerrain& v) { generateRandomTerrain(v, 77, 0.06f); });
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const std::vector<Vec3f> hullPoints = {{-0.6f, -0.2f, -0.3f}, {0.7f, -0.3f, -0.2f}, {0.f, 0.5f, -0.3f},
+                                         {0.1f, 0.f, 0.6f},     {-0.3f, 0.3f, 0.4f},  {0.4f, 0.4f, 0.1f}};
+  TerrainContactPlan plan;
+  std::vector<Contact> want, got;
+  std::vector<Contact> pieceContacts;
+  std::vector<Vec3f> pieceNormals, normals;
+  uint32_t planned = 0, cuts = 0;
+  for (int q = 0; q < 400; ++q) {
+    const float size = 0.2f + 5.8f * u(rng) * u(rng);  // mostly small, some spanning chunks
+    QueryShape shape;
+    switch (q % 4) {
+      case 0: shape = QueryShape::sphere(size * 0.5f); break;
+      case 1: shape = QueryShape::box(Vec3f(size * 0.5f, size * (0.05f + 0.45f * u(rng)), size * 0.3f)); break;
+      case 2: shape = QueryShape::capsule(size * 0.2f, size * 0.4f); break;
+      default: shape = QueryShape::hull(hullPoints.data(), uint32_t(hullPoints.size())); break;
+    }
+    const Vec3f local(u(rng) * 24.f, u(rng) * 12.f, u(rng) * 24.f);
+    const RigidTransform pose{place.pointToWorld(local), Quatf(Eigen::AngleAxisf(6.f * u(rng), Vec3f(u(rng), u(rng), 1).normalized()))};
+    const float spec = 0.05f * u(rng);
+    want.clear();
+    terrainContacts(terrain, shape, pose, spec, want);  // fills the cache for the plan
+    ASSERT_TRUE(plan.plan(terrain, shape, pose, spec)) << q;
+    const uint32_t n = plan.triangleCount();
+    planned += n > 0;
+    got.clear();
+    normals.clear();
+    for (uint32_t begin = 0; begin < n;) {
+      const uint32_t end = std::min(n, begin + 1 + uint32_t(u(rng) * 6.f));
+      pieceContacts.clear();
+      pieceNormals.clear();
+      plan.contactsOfTriangles(begin, end, pieceContacts, pieceNormals);
+      ASSERT_EQ(pieceContacts.size(), pieceNormals.size());
+      got.insert(got.end(), pieceContacts.begin(), pieceContacts.end());
+      normals.insert(normals.end(), pieceNormals.begin(), pieceNormals.end());
+      begin = end;
+      ++cuts;
+    }
+    finishTerrainContacts(got, 0, normals);
+    ASSERT_EQ(got.size(), want.size()) << q;
+    for (size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].position, want[i].position) << q << " contact " << i;
+      EXPECT_EQ(got[i].normal, want[i].normal) << q;
+      EXPECT_EQ(got[i].depth, want[i].depth) << q;
+      EXPECT_EQ(got[i].featureB, want[i].featureB) << q;
+      EXPECT_EQ(got[i].material, want[i].material) << q;
+    }
+  }
+  EXPECT_GT(planned, 150u);
+  EXPECT_GT(cuts, 1000u);
+  EXPECT_THROW(plan.contactsOfTriangles(0, plan.triangleCount() + 1, got, normals), InvalidInput);
+}
+
+TEST(TerrainContactPlan, RefusesChunksNotYetMeshed) {
+  const auto holder = flatTerrain();
+  Terrain& terrain = *holder;
+  const Placed box = boxAt(Vec3d(10.3, 4.45, 10.4), Quatf::Identity(), Vec3f(0.5f, 0.5f, 0.5f));
+  TerrainContactPlan plan;
+  EXPECT_FALSE(plan.plan(terrain, box.shape, box.pose, 0.f));  // nothing meshed yet
+  EXPECT_EQ(plan.triangleCount(), 0u);
+  std::vector<Contact> contacts;
+  ASSERT_GE(terrainContacts(terrain, box, 0.f, contacts), 4u);
+  ASSERT_TRUE(plan.plan(terrain, box.shape, box.pose, 0.f));
+  EXPECT_GT(plan.triangleCount(), 0u);
+  EXPECT_THROW(plan.plan(terrain, box.shape, box.pose, -1.f), InvalidInput);
+}
+
 }  // namespace
 }  // namespace bw

@@ -1,0 +1,42 @@
+#pragma once
+/// The per-substep scratch of World::terrainPairs (world/terrain_pairs.cpp), kept between steps
+/// so a steady-state step allocates nothing: the queries, each one's plan, and the pieces its
+/// candidate triangles are cut into (so one body lying across many triangles is spread over
+/// several jobs), each piece with its own output.
+#include <cstdint>
+#include <vector>
+
+#include "collision/bricks/query_shape.h"
+#include "collision/core/rigid_transform.h"
+#include "collision/terrain/terrain_contacts.h"
+
+namespace bw {
+
+struct TerrainPairWork {
+  struct Query {
+    uint32_t pair, body, terrain;
+    RigidTransform pose;  // the body's shape (or its grid's hull) in the world
+    QueryShape shape;
+    float margin = 0.f;
+    bool cached = false;  // planned from cached chunks (else queried again in pair order)
+    bool wet = false;
+    WaterContact water;
+    uint32_t firstPiece = 0, pieceCount = 0;
+  };
+  struct Piece {
+    uint32_t query, begin, end;  // candidate triangles [begin, end) of that query's plan
+  };
+  struct PieceOutput {
+    std::vector<Contact> contacts;
+    std::vector<Vec3f> faceNormals;
+  };
+
+  std::vector<Query> queries;
+  std::vector<TerrainContactPlan> plans;   // one per query (grows, never shrinks)
+  std::vector<Piece> pieces;
+  std::vector<PieceOutput> pieceOutputs;   // one per piece (grows, never shrinks)
+  std::vector<uint8_t> bodyQueried;        // per body: has a query this substep (all 0 between)
+  bool bodiesUnique = true;                // no body has two queries (then buoyancy runs per query in parallel)
+};
+
+}  // namespace bw
