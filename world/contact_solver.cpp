@@ -301,26 +301,30 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, const
     ProfileZone zone(profiler, relax ? "relax: colouring" : "colouring", waveStage(stage, wave), true);
     colouring_.colour(island, contacts_, motion);
     colours = colouring_.colours();
-    if (!relax)
-      for (uint32_t c : colouring_.all()) warmStart(contacts_[c]);
   }
-  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
-  for (int it = 0; it < iterations; ++it) {
+  // One pass over the colours in order: each colour's contacts in parallel (no two share a
+  // dynamic body), the serial group last, on one thread.
+  const auto wavePass = [&](const char* zoneName, bool reversed, auto&& perContact) {
     for (uint32_t i = 0; i < colours; ++i) {
-      const uint32_t c = (it & 1) ? colours - 1 - i : i;
+      const uint32_t c = reversed ? colours - 1 - i : i;
       const std::span<const uint32_t> group = colouring_.colour(c);
       const int32_t waveId = waveStage(stage, wave);
       if (c == kMaxColours) {  // the serial group: contacts may share bodies
-        ProfileZone zone(profiler, name, waveId, true);
-        for (uint32_t k : group) solveContact(contacts_[k], relax);
+        ProfileZone zone(profiler, zoneName, waveId, true);
+        for (uint32_t k : group) perContact(contacts_[k]);
         continue;
       }
       jobs.parallelFor(0, uint32_t(group.size()), kColourGrain, [&](uint32_t cb, uint32_t ce) {
-        ProfileZone zone(profiler, name, waveId);
-        for (uint32_t j = cb; j < ce; ++j) solveContact(contacts_[group[j]], relax);
+        ProfileZone zone(profiler, zoneName, waveId);
+        for (uint32_t j = cb; j < ce; ++j) perContact(contacts_[group[j]]);
       });
     }
-  }
+  };
+  // note: colour by colour, each body gets its contacts' warm-start impulses in the order of
+  // colouring_.all(), as a serial pass over it would: the result is the same.
+  if (!relax) wavePass("warm start", false, [&](SolverContact& s) { warmStart(s); });
+  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
+  for (int it = 0; it < iterations; ++it) wavePass(name, it & 1, [&](SolverContact& s) { solveContact(s, relax); });
   if (!relax && settings.shockPropagation) {  // one serial sweep over the whole pile
     ProfileZone zone(profiler, "shock sweep", waveStage(stage, wave), true);
     std::vector<uint32_t> list(colouring_.all().begin(), colouring_.all().end());

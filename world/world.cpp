@@ -2,6 +2,7 @@
 // relax, sleep), then the ray load. Each stage lives in its own file; this one orchestrates.
 #include "world/world.h"
 
+#include <atomic>
 #include <chrono>
 
 #include "collision/core/argument_checks.h"
@@ -122,17 +123,29 @@ void World::substep(float dt, int index) {
   }
   stats_.solverMs += msSince(t);
   if (scene_.settings.sleeping) sleep_.update(bodies_, islands_, dt, jobs_, profiler_, stage + 7);
-  ProfileZone counters(profiler_, "counters", stage + kContactStepsStage + 7);
   stats_.pairs += uint32_t(pairs_.size());
   stats_.contacts += uint32_t(solver_.contacts().size());
-  for (uint32_t k = 0; k < pairs_.size(); ++k) {
-    markNearSolid(k);
-    if (pairReused_[k]) {
-      ++stats_.pairsReused;
-      continue;
+  // The pairs' counters and containment's filter, in parallel: integer sums per job.
+  const uint32_t n = uint32_t(pairs_.size());
+  const uint32_t grain = tuning::grainFor(n, tuning::kMinCounterGrain);
+  pairCounters_.assign(JobSystem::chunkCount(0, n, grain), PairCounters{});
+  jobs_.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler_, "counters", stage + kContactStepsStage + 7);
+    PairCounters& c = pairCounters_[begin / grain];
+    for (uint32_t k = begin; k < end; ++k) {
+      markNearSolid(k);
+      if (pairReused_[k]) {
+        ++c.reused;
+        continue;
+      }
+      c.boxTests += pairStats_[k].index.boxTests;
+      c.bricksTested += pairStats_[k].bricksTested;
     }
-    stats_.boxTests += pairStats_[k].index.boxTests;
-    stats_.narrowphase += pairStats_[k].bricksTested;
+  });
+  for (const PairCounters& c : pairCounters_) {
+    stats_.pairsReused += c.reused;
+    stats_.boxTests += c.boxTests;
+    stats_.narrowphase += c.bricksTested;
   }
 }
 
@@ -143,8 +156,11 @@ void World::substep(float dt, int index) {
 // changed its motion), is not; every other pair with a solid body is (reused, skipped, terrain).
 void World::markNearSolid(uint32_t k) {
   const BodyPair& p = pairs_[k];
+  // note: pairs of one body may be marked by two jobs at once: relaxed atomic stores of 1.
+  const auto mark = [&](uint32_t body) { std::atomic_ref<uint8_t>(nearSolid_[body]).store(1, std::memory_order_relaxed); };
   if (!pairContacts_[k].empty()) {
-    nearSolid_[p.a] = nearSolid_[p.b] = 1;  // touched something: any impulse may push it anywhere
+    mark(p.a);  // touched something: any impulse may push it anywhere
+    mark(p.b);
     return;
   }
   const bool solidA = isSolid(p.a), solidB = isSolid(p.b);
@@ -152,8 +168,8 @@ void World::markNearSolid(uint32_t k) {
   const bool collided = !pairReused_[k] && canCollide(p.a, p.b) && (active(p.a) || active(p.b)) &&
                         !bodies_.shape[p.a].isTerrain() && !bodies_.shape[p.b].isTerrain();
   if (collided && pairStats_[k].bricksTested == 0 && pairStats_[k].lodBoxes == 0) return;
-  if (solidA) nearSolid_[p.b] = 1;
-  if (solidB) nearSolid_[p.a] = 1;
+  if (solidA) mark(p.b);
+  if (solidB) mark(p.a);
 }
 
 // After grid edits: bodies resting on an edited grid wake up (a removed brick must let them

@@ -231,6 +231,11 @@ class World {
   std::vector<std::unique_ptr<Terrain>> terrains_;
   std::vector<float> waterDensity_;
   BodyStore bodies_;
+  struct PairCounters {
+    uint64_t boxTests = 0;
+    uint32_t bricksTested = 0, reused = 0;
+  };
+  std::vector<PairCounters> pairCounters_;  // per job of the counters stage, summed in order
   std::vector<uint8_t> nearSolid_;     // per body: came near a grid or terrain in this step (containment's filter)
   bool boundsCurrent_ = false;         // bounds_ hold every body as it is now (a step ran, no setPoses since)
   std::vector<uint32_t> solidBodies_;  // grid and terrain bodies, ascending (what bodies can be inside)

@@ -21,13 +21,14 @@ inline constexpr uint32_t grainFor(uint32_t items, uint32_t minGrain) {
 /// Coulomb friction coefficient of every body (a pair uses sqrt(fa * fb)): rough plastic.
 inline constexpr float kDefaultFriction = 0.6f;
 /// Fewest bodies per job of the per-body stages (gravity and bounds, integration, sleeping): a
-/// body costs tens of nanoseconds, so 128 of them (a few microseconds) amortise a job's
-/// scheduling (about a microsecond).
-inline constexpr uint32_t kMinBodyGrain = 128;
+/// body costs tens of nanoseconds, so 32 of them (a microsecond or two) amortise a job's
+/// scheduling (a fraction of a microsecond in oneTBB); 128 left scenes of a few hundred bodies
+/// (monument) with two or three jobs per stage.
+inline constexpr uint32_t kMinBodyGrain = 32;
 inline constexpr uint32_t bodyGrain(uint32_t bodies) { return grainFor(bodies, kMinBodyGrain); }
 /// Fewest contacts per job of the islands' union-find (a union is a few loads and one
-/// compare-and-swap).
-inline constexpr uint32_t kMinIslandGrain = 256;
+/// compare-and-swap): 64 (was 256, two jobs for monument's few hundred contacts).
+inline constexpr uint32_t kMinIslandGrain = 64;
 
 // --- Broadphase and speculative contacts --------------------------------------------------
 /// Body bounds grow by this (m) beyond how far the body can move in one frame, so resting
@@ -74,8 +75,12 @@ inline constexpr uint32_t kSplitContacts = 512;
 /// Colours per split island (one bit each in a 64-bit mask); contacts left over form a last,
 /// serial group.
 inline constexpr uint32_t kMaxColours = 64;
-/// Contacts per job when a colour is solved in parallel.
-inline constexpr uint32_t kColourGrain = 64;
+/// Contacts per job when a colour is solved in parallel: a contact costs tens of nanoseconds, so
+/// 16 of them amortise a job; colours run one after another (eight iterations of them per
+/// substep), so a coarser grain lengthens the chain a many-threaded machine waits on.
+inline constexpr uint32_t kColourGrain = 16;
+/// Fewest pairs per job of the step's counters (a few loads and adds per pair).
+inline constexpr uint32_t kMinCounterGrain = 256;
 /// Pairs per job in contact generation (a pair may be a grid query of many bricks).
 inline constexpr uint32_t kPairGrain = 4;
 /// Fewest items per job of the terrain stages: one (a query's plan or a piece of its triangles).
