@@ -22,6 +22,7 @@ void World::findPairs() {
   proxyStatic_.clear();
   proxyBody_.clear();
   for (uint32_t i = 0; i < n; ++i) {
+    if (bodies_.shape[i].isGrid() && grids_[bodies_.shape[i].grid]->brickCount() == 0) continue;  // edited away: meets nothing
     const bool covered = isStatic_[i] && bodies_.shape[i].isGrid() && grids_[bodies_.shape[i].grid]->brickCount() >= tuning::kCoverMinBricks;
     if (!covered) {
       proxyBounds_.push_back(bounds_[i]);

@@ -33,6 +33,8 @@ WorldAabb World::boundsOf(uint32_t i, float& reach) const {
     Aabb b;
     if (bodies_.shape[i].isGrid()) {
       b = grids_[bodies_.shape[i].grid]->bounds();
+      // note: a grid edited down to no bricks is a point at its origin (and gets no proxy).
+      if (b.isEmpty()) b = {Vec3f::Zero(), Vec3f::Zero()};
     } else {
       const Terrain& t = *terrains_[bodies_.shape[i].terrain];
       const Int3 size = t.voxels().size();

@@ -48,7 +48,12 @@ std::vector<Brick> World::gridBricks(const GridDescription& g, std::vector<Build
 void World::buildGrid(const GridDescription& g) {
   std::vector<BuildLight> lights;
   const std::vector<Brick> bricks = gridBricks(g, lights);
-  auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(bricks.size() + 1024)));
+  // The pool (a virtual reservation) holds the bricks the scene's edit load places over four
+  // times the scene's frames (a longer `run --frames` ends with a clear pool-full error).
+  uint64_t reserve = bricks.size() + 1024;
+  for (const EditLoadDescription& e : scene_.edits)
+    if (e.grid == g.name) reserve += plannedPlacements(e, 4ull * scene_.settings.frames);
+  auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(std::min<uint64_t>(reserve, 1u << 28))));
   for (const Brick& b : bricks) grid->placeBrick(b);
   grids_.push_back(std::move(grid));
   gridNames_.push_back(g.name);

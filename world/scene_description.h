@@ -33,6 +33,8 @@ constexpr uint32_t kMaxSpawnCount = 1'000'000;
 constexpr double kMaxRayLength = 1e7;
 constexpr double kMinRenderChunk = 0.1, kMaxRenderChunk = 1e4;  ///< grid render chunk edge
 constexpr uint32_t kMaxBatchCapacity = 1u << 28;                 ///< records per frame in a batch
+constexpr uint32_t kMaxEditsPerFrame = 1'000'000;                ///< bricks or holes per edit stream per frame
+constexpr uint32_t kMaxWallLength = 100'000;                     ///< bricks per course of an edit wall
 }  // namespace scene_limits
 
 /// How a body moves.
@@ -103,6 +105,28 @@ struct AttachmentsDescription {
   uint32_t batchPrimitives = 0, batchLights = 0;
 };
 
+/// Edits a scene makes to one of its grids while it runs, between steps (World::step applies a
+/// frame's edits before simulating it). Seeded: every run, at any thread count, edits the same
+/// bricks in the same order.
+struct EditLoadDescription {
+  enum class Kind : uint8_t {
+    Remove,  ///< perFrame bricks, chosen at random among the grid's bricks
+    Place,   ///< perFrame bricks: copies of random bricks laid on top of (or beside) them where free
+    Carve,   ///< perFrame holes: every brick whose centre lies within radius of a random brick's
+    Wall,    ///< perFrame bricks of a wall rising course by course on top of the grid
+  };
+  std::string grid;                 ///< name of a grid in grids
+  Kind kind = Kind::Remove;
+  uint32_t perFrame = 1;            ///< bricks (Remove, Place, Wall) or holes (Carve) per edit frame
+  uint32_t firstFrame = 0;          ///< the first frame that edits
+  uint32_t lastFrame = UINT32_MAX;  ///< the last frame that edits
+  uint32_t every = 1;               ///< edit on every this many frames from firstFrame
+  float radius = 1.f;               ///< Carve: hole radius, grid units
+  Vec3f brickHalfSize = Vec3f(0.5f, 0.25f, 0.25f);  ///< Wall: half size of its bricks
+  uint32_t wallLength = 32;         ///< Wall: bricks per course
+  uint64_t seed = 1;
+};
+
 /// What the world does with a dynamic body that starts inside solid (depenetration.h).
 enum class StartInSolid : uint8_t { PushOut, Refuse };
 
@@ -137,6 +161,7 @@ struct SceneDescription {
   std::vector<TerrainDescription> terrains;
   RayLoadDescription rays;
   AttachmentsDescription attachments;
+  std::vector<EditLoadDescription> edits;
 };
 
 }  // namespace bw

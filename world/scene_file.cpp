@@ -1,5 +1,6 @@
 #include "world/scene_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -301,6 +302,31 @@ AttachmentsDescription parseAttachments(const Field& f) {
   return a;
 }
 
+EditLoadDescription parseEdit(const Field& f, const std::vector<GridDescription>& grids) {
+  f.allowOnly({"grid", "kind", "per_frame", "first_frame", "last_frame", "every", "radius", "brick_half_size", "wall_length", "seed"});
+  using namespace scene_limits;
+  EditLoadDescription e;
+  const Field g = f.at("grid");
+  e.grid = g.string();
+  if (std::none_of(grids.begin(), grids.end(), [&](const GridDescription& d) { return d.name == e.grid; }))
+    g.fail("the name of a grid declared in \"grids\"");
+  const std::string kind = f.at("kind").oneOf({"remove", "place", "carve", "wall"});
+  e.kind = kind == "remove" ? EditLoadDescription::Kind::Remove
+         : kind == "place"  ? EditLoadDescription::Kind::Place
+         : kind == "carve"  ? EditLoadDescription::Kind::Carve
+                            : EditLoadDescription::Kind::Wall;
+  if (f.has("per_frame")) e.perFrame = uint32_t(f.at("per_frame").integer(1, kMaxEditsPerFrame));
+  if (f.has("first_frame")) e.firstFrame = uint32_t(f.at("first_frame").integer(0, UINT32_MAX));
+  if (f.has("last_frame")) e.lastFrame = uint32_t(f.at("last_frame").integer(0, UINT32_MAX));
+  if (e.lastFrame < e.firstFrame) f.at("last_frame").fail("a frame at or after first_frame (" + std::to_string(e.firstFrame) + ")");
+  if (f.has("every")) e.every = uint32_t(f.at("every").integer(1, UINT32_MAX));
+  if (f.has("radius")) e.radius = float(f.at("radius").number(kMinSize, kMaxSize));
+  if (f.has("brick_half_size")) e.brickHalfSize = f.at("brick_half_size").vec3(kMinSize, kMaxSize).cast<float>();
+  if (f.has("wall_length")) e.wallLength = uint32_t(f.at("wall_length").integer(1, kMaxWallLength));
+  if (f.has("seed")) e.seed = f.at("seed").seed();
+  return e;
+}
+
 }  // namespace
 
 SceneDescription parseScene(const std::string& jsonText, const std::string& sourceName) {
@@ -311,7 +337,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     throw SceneError(sourceName + ": not valid JSON (" + e.what() + ")");
   }
   const Field root(doc, "scene", sourceName);
-  root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays", "attachments"});
+  root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays", "attachments", "edits"});
   SceneDescription scene;
   scene.source = sourceName;
   scene.name = root.at("name").string();
@@ -339,6 +365,11 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
   }
   if (root.has("rays")) scene.rays = parseRays(root.at("rays"));
   if (root.has("attachments")) scene.attachments = parseAttachments(root.at("attachments"));
+  if (root.has("edits")) {
+    const Field edits = root.at("edits");
+    const size_t n = edits.arraySize(1'000);
+    for (size_t i = 0; i < n; ++i) scene.edits.push_back(parseEdit(edits.index(i), scene.grids));
+  }
   if (scene.grids.empty() && scene.spawners.empty() && scene.terrains.empty())
     root.failMessage("declares no grids, spawners or terrains: nothing to simulate");
   return scene;

@@ -1,5 +1,6 @@
 #include "world/scene_validation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -104,6 +105,18 @@ void validateScene(const SceneDescription& scene) {
     if (t.waterFirst >= 0 && (t.waterFirst > t.waterLast || t.waterLast > 255)) c.message(f + ".water", "expected 1 <= first <= last <= 255");
   }
   c.number("rays.length", scene.rays.length, 0, kMaxRayLength);
+  for (size_t i = 0; i < scene.edits.size(); ++i) {
+    const EditLoadDescription& e = scene.edits[i];
+    const std::string f = "edits[" + std::to_string(i) + "]";
+    if (std::none_of(scene.grids.begin(), scene.grids.end(), [&](const GridDescription& g) { return g.name == e.grid; }))
+      c.message(f + ".grid", "expected the name of a grid declared in grids, got '" + e.grid + "'");
+    c.number(f + ".per_frame", e.perFrame, 1, kMaxEditsPerFrame);
+    c.number(f + ".every", e.every, 1, UINT32_MAX);
+    if (e.lastFrame < e.firstFrame) c.message(f + ".last_frame", "is before first_frame");
+    c.number(f + ".radius", e.radius, kMinSize, kMaxSize);
+    c.vector(f + ".brick_half_size", e.brickHalfSize, kMinSize, kMaxSize);
+    c.number(f + ".wall_length", e.wallLength, 1, kMaxWallLength);
+  }
   if (scene.attachments.enabled) {
     c.number("attachments.render_chunk", scene.attachments.renderChunk, kMinRenderChunk, kMaxRenderChunk);
     c.number("attachments.batch_capacity.primitives", scene.attachments.batchPrimitives, 0, kMaxBatchCapacity);

@@ -2,6 +2,7 @@
 // relax, sleep), then the ray load. Each stage lives in its own file; this one orchestrates.
 #include "world/world.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 
@@ -25,6 +26,10 @@ World::World(const SceneDescription& scene, int threads, SubmissionMode submissi
   for (const GridDescription& g : scene_.grids) buildGrid(g);
   for (const TerrainDescription& t : scene_.terrains) buildTerrain(t);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
+  std::vector<uint32_t> editGrids;
+  for (const EditLoadDescription& e : scene_.edits)
+    editGrids.push_back(uint32_t(std::find(gridNames_.begin(), gridNames_.end(), e.grid) - gridNames_.begin()));
+  editLoad_ = EditLoad(scene_.edits, std::move(editGrids));
   for (uint32_t i = 0; i < bodies_.size(); ++i)
     if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) solidBodies_.push_back(i);
   nearSolid_.assign(bodies_.size(), 1);  // no step yet: containment checks every body
@@ -215,9 +220,24 @@ void World::step() {
   const auto t = Clock::now();
   stats_ = StepStats{};
   nearSolid_.assign(bodies_.size(), 0);
-  applyGridEdits();
-  advanceDepenetration();
   profiler_.beginFrame(frame_);
+  {
+    ProfileZone z(profiler_, "edits", kEditStage, true);
+    if (!editLoad_.empty()) {
+      const auto load = Clock::now();
+      const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_);
+      stats_.bricksRemoved = e.removed;
+      stats_.bricksPlaced = e.placed;
+      stats_.editsSkipped = e.skipped;
+      stats_.editMs = e.gridEditMs;
+      stats_.editLoadMs = msSince(load) - e.gridEditMs;
+    }
+    const auto apply = Clock::now();
+    const bool edited = !editedGrids_.empty();
+    applyGridEdits();
+    if (edited) stats_.editMs += msSince(apply);
+  }
+  advanceDepenetration();
   const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
   for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt, s);
   boundsCurrent_ = true;

@@ -35,6 +35,7 @@
 #include "world/containment.h"
 #include "world/contact_solver.h"
 #include "world/depenetration.h"
+#include "world/edit_load.h"
 #include "world/islands.h"
 #include "world/pair_cache.h"
 #include "world/ray_load.h"
@@ -61,6 +62,10 @@ struct StepStats {
   uint32_t largestIsland = 0;    ///< contacts in the largest island (last substep)
   uint32_t splitIslands = 0;     ///< islands solved colour by colour on every thread
   RenderStageStats render;       ///< frame steps 5-7 (zero without attachments)
+  double editMs = 0;             ///< the frame's edits: bricks placed and removed (index, mass), then wakes, body mass, pair caches
+  double editLoadMs = 0;         ///< the scene's edit load choosing what to edit (random picks, free-spot checks)
+  uint32_t bricksRemoved = 0, bricksPlaced = 0;  ///< by the scene's edit load this frame
+  uint32_t editsSkipped = 0;     ///< edit load placements with no free spot (or removals of nothing)
 };
 
 class World {
@@ -273,6 +278,10 @@ class World {
   SleepState sleep_;
   RayLoad rayLoad_;
   std::vector<uint32_t> editedGrids_;  // grids handed out by editGrid() since the last step
+  EditLoad editLoad_;                  // the scene's edits, applied at the start of each step
+  // The edits' profiling stage: one serial stage before the substeps' (they run first), below
+  // the coloured islands' wave stages.
+  static constexpr int kEditStage = 1 << 19;
   StepStats stats_;
   uint32_t frame_ = 0;
   int stage_ = 0;  // first profiling stage id of the running substep

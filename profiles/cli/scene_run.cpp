@@ -176,15 +176,18 @@ int runScene(const SceneRunOptions& o) {
   const double buildMs = std::chrono::duration<double, std::milli>(Clock::now() - tBuild).count();
   const uint32_t frames = o.frames ? o.frames : scene.settings.frames;
 
-  Series total, broad, contacts, solver, integrate, rays;
+  Series total, broad, contacts, solver, integrate, rays, edits;
   uint64_t pairs = 0, contactCount = 0, boxTests = 0, reused = 0, rayCount = 0, rayHits = 0, rayBoxTests = 0, terrainContacts = 0;
+  uint64_t removed = 0, placed = 0, editSkipped = 0;
+  double editMsTotal = 0, editLoadMsTotal = 0;
   uint32_t floating = 0, largestIsland = 0, splitIslands = 0;
   std::ofstream csv;
   if (!o.csvPath.empty()) {
     csv.open(o.csvPath);
     if (!csv) throw std::runtime_error("cannot write " + o.csvPath);
     csv << "frame,total_ms,broadphase_ms,contacts_ms,solver_ms,integrate_ms,rays_ms,pairs,contacts,box_tests,ray_hits,"
-           "bodies_inside_solid,transform_update_ms,submission_ms,commit_ms,render_wait_ms,render_busy_ms,moved_bodies,records\n";
+           "bodies_inside_solid,transform_update_ms,submission_ms,commit_ms,render_wait_ms,render_busy_ms,moved_bodies,records,"
+           "edit_ms,bricks_removed,bricks_placed\n";
   }
   double work = 0, span = 0;
   float deepest = 0, endDeepest = 0;  // deepest contact over the run and in the last frame
@@ -209,6 +212,12 @@ int runScene(const SceneRunOptions& o) {
     solver.v.push_back(s.solverMs);
     integrate.v.push_back(s.integrateMs);
     rays.v.push_back(s.raysMs);
+    edits.v.push_back(s.editMs);
+    editMsTotal += s.editMs;
+    editLoadMsTotal += s.editLoadMs;
+    removed += s.bricksRemoved;
+    placed += s.bricksPlaced;
+    editSkipped += s.editsSkipped;
     if (world.render()) render.add(s.render);
     rayCount += s.rays;
     rayHits += s.rayHits;
@@ -225,7 +234,8 @@ int runScene(const SceneRunOptions& o) {
                  << s.integrateMs << "," << s.raysMs << "," << s.pairs << "," << s.contacts << "," << s.boxTests << "," << s.rayHits
                  << "," << containment.report().count() << "," << s.render.updateMs << "," << s.render.submissionMs << ","
                  << s.render.commitMs << "," << s.render.waitMs << "," << s.render.renderBusyMs << "," << s.render.movedBodies << ","
-                 << s.render.primitives + s.render.lights << "\n";
+                 << s.render.primitives + s.render.lights << "," << s.editMs << "," << s.bricksRemoved << "," << s.bricksPlaced
+                 << "\n";
     if (o.progress && !o.json && frames >= 100 && (f + 1) % (frames / 10) == 0)
       std::fprintf(stderr, "  frame %u/%u  %.2f ms\n", f + 1, frames, s.totalMs);
   }
@@ -296,6 +306,14 @@ int runScene(const SceneRunOptions& o) {
       j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
       j["dynamic_floating"] = floating;
     }
+    if (!scene.edits.empty()) {
+      j["edits"] = stage(edits);
+      j["bricks_removed_per_frame"] = double(removed) / frames;
+      j["bricks_placed_per_frame"] = double(placed) / frames;
+      j["edits_skipped_per_frame"] = double(editSkipped) / frames;
+      j["edit_us_per_brick"] = removed + placed ? 1e3 * editMsTotal / double(removed + placed) : 0.0;
+      j["edit_load_choosing_ms_per_frame"] = editLoadMsTotal / frames;
+    }
     if (rayCount) {
       j["rays"] = stage(rays);
       j["rays_per_frame"] = double(rayCount) / frames;
@@ -322,8 +340,9 @@ int runScene(const SceneRunOptions& o) {
               path.c_str(), world.bodies().size(), (unsigned long long)world.brickCount(), buildMs, frames, o.threads, runS);
   std::printf("  %-11s %9s %9s %9s\n", "stage", "median", "p95", "max");
   for (auto [name, s] : {std::pair<const char*, const Series*>{"frame", &total}, {"broadphase", &broad}, {"contacts", &contacts},
-                         {"solver", &solver}, {"integrate", &integrate}, {"rays", &rays}}) {
+                         {"solver", &solver}, {"integrate", &integrate}, {"rays", &rays}, {"edits", &edits}}) {
     if (s == &rays && rayCount == 0) continue;
+    if (s == &edits && scene.edits.empty()) continue;
     std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
   }
   std::printf("  simulation %.0f ms; bookkeeping (containment, counters, CSV, work/span, trace) %.0f ms = %.1f%% of it\n",
@@ -335,6 +354,11 @@ int runScene(const SceneRunOptions& o) {
   if (rayCount)
     std::printf("  rays: %.0f per frame, %.1f%% hit, %.0f box tests per ray\n", double(rayCount) / frames,
                 100.0 * double(rayHits) / double(rayCount), double(rayBoxTests) / double(rayCount));
+  if (!scene.edits.empty())
+    std::printf("  edits: %.0f bricks removed and %.0f placed per frame (%.1f skipped), %.2f us per brick edited (index, mass, "
+                "wakes, caches); the load's own choosing %.3f ms per frame, outside the edit times\n",
+                double(removed) / frames, double(placed) / frames, double(editSkipped) / frames,
+                removed + placed ? 1e3 * editMsTotal / double(removed + placed) : 0.0, editLoadMsTotal / frames);
   if (!scene.terrains.empty())
     std::printf("  terrain: %.0f contacts per frame, %u bodies in water at the end\n", double(terrainContacts) / frames, floating);
   std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
