@@ -53,7 +53,8 @@ void EditLoad::LiveBricks::drop(uint32_t id) {
   slot[id] = ~0u;
 }
 
-uint32_t EditLoad::timedPlace(BrickGrid& grid, const Brick& b, EditLoadStats& st) {
+uint32_t EditLoad::timedPlace(uint32_t gridIndex, BrickGrid& grid, const Brick& b, EditLoadStats& st) {
+  touched_.push_back({gridIndex, brickBounds(b)});
   const auto t = std::chrono::steady_clock::now();
   const uint32_t id = grid.placeBrick(b);
   st.gridEditMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -61,7 +62,8 @@ uint32_t EditLoad::timedPlace(BrickGrid& grid, const Brick& b, EditLoadStats& st
   return id;
 }
 
-void EditLoad::timedRemove(BrickGrid& grid, uint32_t id, EditLoadStats& st) {
+void EditLoad::timedRemove(uint32_t gridIndex, BrickGrid& grid, uint32_t id, EditLoadStats& st) {
+  touched_.push_back({gridIndex, brickBounds(grid.brick(id))});
   const auto t = std::chrono::steady_clock::now();
   grid.removeBrick(id);
   st.gridEditMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -77,13 +79,19 @@ uint64_t EditLoad::next(Stream& s) {  // splitmix64
 
 uint32_t EditLoad::below(Stream& s, uint32_t n) { return uint32_t(((next(s) >> 32) * uint64_t(n)) >> 32); }
 
-bool EditLoad::isFree(const BrickGrid& grid, const Brick& b) {
+bool EditLoad::isFree(uint32_t gridIndex, const BrickGrid& grid, const Brick& b) {
   // Shrunk a little: a brick may touch its neighbours face to face, not overlap them.
   const Aabb box = brickBounds(b);
   const Vec3f inset = box.halfExtent() * 0.02f;
   scratch_.clear();
   grid.overlapBricks(Aabb{box.min + inset, box.max - inset}, ~0u, scratch_);
-  return scratch_.empty();
+  return scratch_.empty() && !(blocked_ && *blocked_ && (*blocked_)(gridIndex, box));
+}
+
+bool EditLoad::places() const {
+  return std::any_of(streams_.begin(), streams_.end(), [](const Stream& s) {
+    return s.d.kind == EditLoadDescription::Kind::Place || s.d.kind == EditLoadDescription::Kind::Wall;
+  });
 }
 
 void EditLoad::remove(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st) {
@@ -93,7 +101,7 @@ void EditLoad::remove(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStat
       return;
     }
     const uint32_t id = live.ids[below(s, uint32_t(live.ids.size()))];
-    timedRemove(grid, id, st);
+    timedRemove(s.grid, grid, id, st);
     live.drop(id);
   }
 }
@@ -109,8 +117,8 @@ void EditLoad::place(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats
       for (uint32_t t = 0; t < 5 && !done; ++t) {
         Brick b = from;
         b.position += offsets[t];
-        if (!isFree(grid, b)) continue;
-        live.add(timedPlace(grid, b, st));
+        if (!isFree(s.grid, grid, b)) continue;
+        live.add(timedPlace(s.grid, grid, b, st));
         done = true;
       }
     }
@@ -128,7 +136,7 @@ void EditLoad::carve(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats
     std::sort(scratch_.begin(), scratch_.end());
     for (uint32_t id : scratch_) {
       if ((grid.brick(id).position - centre).squaredNorm() > r * r) continue;
-      timedRemove(grid, id, st);
+      timedRemove(s.grid, grid, id, st);
       live.drop(id);
     }
   }
@@ -150,16 +158,23 @@ void EditLoad::wall(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats&
     // note: courses alternate by half a brick, as masons lay them.
     const float shift = (course & 1) ? h.x() : 0.f;
     const Brick brick = Brick::box(Vec3f(x0 + shift + 2.f * h.x() * float(column), s.wallY, s.wallBase + h.z() + 2.f * h.z() * float(course)), h);
-    if (!isFree(grid, brick)) {
+    if (!isFree(s.grid, grid, brick)) {
       ++st.skipped;
       continue;
     }
-    live.add(timedPlace(grid, brick, st));
+    live.add(timedPlace(s.grid, grid, brick, st));
   }
 }
 
-EditLoadStats EditLoad::apply(uint64_t frame, const std::vector<std::unique_ptr<BrickGrid>>& grids, std::vector<uint32_t>& edited) {
+EditLoadStats EditLoad::apply(uint64_t frame, const std::vector<std::unique_ptr<BrickGrid>>& grids, std::vector<uint32_t>& edited,
+                              const Blocked& blocked) {
   EditLoadStats st;
+  touched_.clear();
+  blocked_ = &blocked;
+  struct Reset {
+    const Blocked*& b;
+    ~Reset() { b = nullptr; }
+  } reset{blocked_};
   for (Stream& s : streams_) {
     if (frame < s.d.firstFrame || frame > s.d.lastFrame || (frame - s.d.firstFrame) % s.d.every != 0) continue;
     BrickGrid& grid = *grids[s.grid];

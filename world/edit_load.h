@@ -12,6 +12,7 @@
 /// the grid's live bricks, which only edits change. A grid edited through World::editGrid
 /// outside the load is noticed (its edit count moved) and its brick list taken again.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -40,8 +41,16 @@ class EditLoad {
   EditLoad(std::vector<EditLoadDescription> streams, std::vector<uint32_t> gridIndex);
 
   bool empty() const { return streams_.empty(); }
+  /// Whether a brick with these grid-local bounds would be built into something other than the
+  /// grid (a body standing there): such spots count as taken.
+  using Blocked = std::function<bool(uint32_t grid, const Aabb& localBounds)>;
   /// Applies frame `frame`'s edits; appends each grid it edited to `edited` (once per stream).
-  EditLoadStats apply(uint64_t frame, const std::vector<std::unique_ptr<BrickGrid>>& grids, std::vector<uint32_t>& edited);
+  EditLoadStats apply(uint64_t frame, const std::vector<std::unique_ptr<BrickGrid>>& grids, std::vector<uint32_t>& edited,
+                      const Blocked& blocked = {});
+  /// Whether any stream places bricks (the caller then has `blocked` answer).
+  bool places() const;
+  /// The grid-local bounds of every brick the last apply() placed or removed, with its grid.
+  const std::vector<std::pair<uint32_t, Aabb>>& touched() const { return touched_; }
 
  private:
   // The live bricks of one grid, for picking one at random in O(1) and dropping one in O(1).
@@ -68,15 +77,17 @@ class EditLoad {
   void place(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
   void carve(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
   void wall(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
-  bool isFree(const BrickGrid& grid, const Brick& b);
+  bool isFree(uint32_t gridIndex, const BrickGrid& grid, const Brick& b);
   static constexpr uint32_t kPlaceSources = 4;  // source bricks a placement tries before it is skipped
   // The grid edits themselves, timed into stats.gridEditMs.
-  uint32_t timedPlace(BrickGrid& grid, const Brick& b, EditLoadStats& st);
-  void timedRemove(BrickGrid& grid, uint32_t id, EditLoadStats& st);
+  uint32_t timedPlace(uint32_t gridIndex, BrickGrid& grid, const Brick& b, EditLoadStats& st);
+  void timedRemove(uint32_t gridIndex, BrickGrid& grid, uint32_t id, EditLoadStats& st);
 
   std::vector<Stream> streams_;
   std::vector<LiveBricks> live_;   // by grid index (only edited grids fill theirs)
   std::vector<uint32_t> scratch_;  // overlap results
+  const Blocked* blocked_ = nullptr;  // during apply()
+  std::vector<std::pair<uint32_t, Aabb>> touched_;
 };
 
 }  // namespace bw

@@ -30,6 +30,9 @@ World::World(const SceneDescription& scene, int threads, SubmissionMode submissi
   for (const EditLoadDescription& e : scene_.edits)
     editGrids.push_back(uint32_t(std::find(gridNames_.begin(), gridNames_.end(), e.grid) - gridNames_.begin()));
   editLoad_ = EditLoad(scene_.edits, std::move(editGrids));
+  gridBodies_.assign(grids_.size(), {});
+  for (uint32_t i = 0; i < bodies_.size(); ++i)
+    if (bodies_.shape[i].isGrid()) gridBodies_[bodies_.shape[i].grid].push_back(i);
   for (uint32_t i = 0; i < bodies_.size(); ++i)
     if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) solidBodies_.push_back(i);
   nearSolid_.assign(bodies_.size(), 1);  // no step yet: containment checks every body
@@ -57,6 +60,7 @@ BrickGrid& World::editGrid(uint32_t index) {
     throw InvalidInput("World::editGrid: index is " + std::to_string(index) + ", the world has " + std::to_string(grids_.size()) +
                        " grids");
   editedGrids_.push_back(index);
+  wholeGridEdits_.push_back(index);  // where it is edited is not known: everything on it wakes
   return *grids_[index];
 }
 
@@ -182,17 +186,80 @@ void World::markNearSolid(uint32_t k) {
 // belong to a brick that is gone).
 void World::applyGridEdits() {
   if (editedGrids_.empty()) return;
+  // Per grid: 0 unedited, 1 edited by the edit load only (which says where: only bodies near
+  // the bricks it placed or removed wake and lose their cached contacts), 2 edited through
+  // editGrid() or holding a dynamic body (everything paired with it wakes and forgets).
   std::vector<uint8_t> edited(grids_.size(), 0);
   for (uint32_t g : editedGrids_) edited[g] = 1;
+  for (uint32_t g : wholeGridEdits_) edited[g] = 2;
   editedGrids_.clear();
-  auto usesEdited = [&](uint32_t body) { return bodies_.shape[body].isGrid() && edited[bodies_.shape[body].grid]; };
-  for (uint32_t body = 0; body < bodies_.size(); ++body)
-    if (usesEdited(body) && bodies_.motion[body] == MotionType::Dynamic) refreshGridBodyMass(body);
+  wholeGridEdits_.clear();
+  for (uint32_t body = 0; body < bodies_.size(); ++body) {
+    if (!bodies_.shape[body].isGrid() || !edited[bodies_.shape[body].grid] || bodies_.motion[body] != MotionType::Dynamic) continue;
+    edited[bodies_.shape[body].grid] = 2;
+    refreshGridBodyMass(body);
+  }
+  // The world boxes of the edit load's bricks, on every body holding their grid.
+  std::vector<WorldAabb> boxes;
+  std::vector<uint32_t> owners;
+  for (const auto& [grid, local] : editLoad_.touched()) {
+    if (edited[grid] != 1) continue;
+    for (uint32_t i : gridBodies_[grid]) {
+      const RigidTransform pose = bodies_.shapePose(i);
+      const Vec3d centre = pose.pointToWorld(local.center());
+      const Vec3d half = (pose.rotation.toRotationMatrix().cwiseAbs() * local.halfExtent()).cast<double>();
+      boxes.push_back({centre - half, centre + half});
+      owners.push_back(i);
+    }
+  }
+  editedBoxes_.build(std::move(boxes), std::move(owners));
+  auto touchesEdit = [&](const BodyPair& p) {
+    for (auto [g, other] : {std::pair{p.a, p.b}, std::pair{p.b, p.a}}) {
+      if (!bodies_.shape[g].isGrid() || !edited[bodies_.shape[g].grid]) continue;
+      if (edited[bodies_.shape[g].grid] == 2) return true;
+      float reach;
+      if (editedBoxes_.any(boundsOf(other, reach), [&](uint32_t holder) { return holder == g; })) return true;
+    }
+    return false;
+  };
+  // Each pair decided once (pairs_ is sorted), then the cache's entries looked up in it.
+  std::vector<BodyPair> touched;
   for (const BodyPair& p : pairs_) {
-    if (!usesEdited(p.a) && !usesEdited(p.b)) continue;
+    if (!touchesEdit(p)) continue;
+    touched.push_back(p);
     for (uint32_t x : {p.a, p.b}) sleep_.wake(x);
   }
-  pairCache_.forget([&](const BodyPair& p) { return usesEdited(p.a) || usesEdited(p.b); });
+  const auto key = [](const BodyPair& p) { return (uint64_t(p.a) << 32) | p.b; };
+  pairCache_.forget([&](const BodyPair& p) {
+    const auto it = std::lower_bound(touched.begin(), touched.end(), p, [&](const BodyPair& x, const BodyPair& y) { return key(x) < key(y); });
+    return it != touched.end() && key(*it) == key(p);
+  });
+}
+
+EditLoad::Blocked World::editBlockers() {
+  if (!editLoad_.places()) return {};
+  // Every dynamic body's box now (its bounds over the coming frame's motion); a planned brick is
+  // tested where each body holding its grid holds it.
+  std::vector<WorldAabb> boxes;
+  std::vector<uint32_t> owners;
+  for (uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_.motion[i] != MotionType::Dynamic) continue;
+    float reach;
+    boxes.push_back(boundsOf(i, reach));
+    owners.push_back(i);
+  }
+  editBodies_.build(std::move(boxes), std::move(owners));
+  return [this](uint32_t grid, const Aabb& local) {
+    for (uint32_t holder : gridBodies_[grid]) {
+      const RigidTransform pose = bodies_.shapePose(holder);
+      const Vec3d centre = pose.pointToWorld(local.center());
+      const Vec3d half = (pose.rotation.toRotationMatrix().cwiseAbs() * local.halfExtent()).cast<double>();
+      const WorldAabb box{centre - half, centre + half};
+      const auto other = [&](uint32_t body) { return !(bodies_.shape[body].isGrid() && bodies_.shape[body].grid == grid); };
+      if (editBodies_.any(box, other)) return true;
+    }
+    return false;
+  };
 }
 
 void World::refreshGridBodyMass(uint32_t body) {
@@ -225,7 +292,7 @@ void World::step() {
     ProfileZone z(profiler_, "edits", kEditStage, true);
     if (!editLoad_.empty()) {
       const auto load = Clock::now();
-      const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_);
+      const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_, editBlockers());
       stats_.bricksRemoved = e.removed;
       stats_.bricksPlaced = e.placed;
       stats_.editsSkipped = e.skipped;

@@ -35,6 +35,7 @@
 #include "world/containment.h"
 #include "world/contact_solver.h"
 #include "world/depenetration.h"
+#include "world/body_box_index.h"
 #include "world/edit_load.h"
 #include "world/islands.h"
 #include "world/pair_cache.h"
@@ -210,6 +211,8 @@ class World {
   void substep(float dt, int index);
   void integrate(float dt, int stage);
   void applyGridEdits();
+  /// What the edit load must not build into: the dynamic bodies (none if it places nothing).
+  EditLoad::Blocked editBlockers();
   /// A dynamic grid body's mass, centre of mass and inertia after its grid was edited.
   void refreshGridBodyMass(uint32_t body);
   // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
@@ -277,8 +280,12 @@ class World {
   Islands islands_;
   SleepState sleep_;
   RayLoad rayLoad_;
-  std::vector<uint32_t> editedGrids_;  // grids handed out by editGrid() since the last step
+  std::vector<uint32_t> editedGrids_;  // grids edited since the last step (editGrid(), the edit load)
+  std::vector<uint32_t> wholeGridEdits_;  // of those, the ones handed out by editGrid()
+  BodyBoxIndex editedBoxes_;           // the edit load's bricks of this frame, in the world
   EditLoad editLoad_;                  // the scene's edits, applied at the start of each step
+  BodyBoxIndex editBodies_;            // dynamic bodies' boxes, built when the edit load places bricks
+  std::vector<std::vector<uint32_t>> gridBodies_;  // per grid: the bodies holding it (built once)
   // The edits' profiling stage: one serial stage before the substeps' (they run first), below
   // the coloured islands' wave stages.
   static constexpr int kEditStage = 1 << 19;
