@@ -1,0 +1,155 @@
+#include "collision/bricks/brick_connectivity.h"
+
+#include <algorithm>
+
+#include "collision/bricks/brick_geometry.h"
+
+namespace bw {
+
+float BrickConnectivity::toleranceAt(const Aabb& a) {
+  // Four float steps of the coordinates at hand, at least kTolerance: bricks far from the grid
+  // origin are placed no finer than that.
+  const float m = std::max(a.min.cwiseAbs().maxCoeff(), a.max.cwiseAbs().maxCoeff());
+  return std::max(kTolerance, m * 4.8e-7f);
+}
+
+bool BrickConnectivity::touches(const Aabb& a, const Aabb& b) {
+  // Overlap length along each axis (negative: a gap). Touching across a face: no gap beyond the
+  // tolerance on any axis, and an overlap beyond it on at least two (an edge or a corner is not
+  // a joint that holds).
+  const float tol = std::max(toleranceAt(a), toleranceAt(b));
+  int across = 0;
+  for (int i = 0; i < 3; ++i) {
+    const float overlap = std::min(a.max[i], b.max[i]) - std::max(a.min[i], b.min[i]);
+    if (overlap < -tol) return false;
+    across += overlap > tol;
+  }
+  return across >= 2;
+}
+
+BrickConnectivity::BrickConnectivity(const BrickGrid& grid) {
+  grid.forEachBrick([&](uint32_t id) {
+    if (id >= adjacency_.size()) adjacency_.resize(size_t(id) + 1);
+  });
+  live_.assign(adjacency_.size(), 0);
+  grid.forEachBrick([&](uint32_t id) {
+    live_[id] = 1;
+    const Aabb box = brickBounds(grid.brick(id));
+    scratch_.clear();
+    grid.overlapBricks(box.expanded(2.f * toleranceAt(box)), ~0u, scratch_);
+    for (uint32_t o : scratch_)
+      if (o > id && touches(box, brickBounds(grid.brick(o)))) link(id, o);
+  });
+}
+
+void BrickConnectivity::link(uint32_t a, uint32_t b) {
+  adjacency_[a].push_back(b);
+  adjacency_[b].push_back(a);
+}
+
+void BrickConnectivity::placed(const BrickGrid& grid, uint32_t id) {
+  if (id >= adjacency_.size()) {
+    adjacency_.resize(size_t(id) + 1);
+    live_.resize(size_t(id) + 1, 0);
+  }
+  adjacency_[id].clear();
+  live_[id] = 1;
+  const Aabb box = brickBounds(grid.brick(id));
+  scratch_.clear();
+  grid.overlapBricks(box.expanded(2.f * toleranceAt(box)), ~0u, scratch_);
+  // note: sorted, so a brick's list (and every search after it) does not depend on the index's order.
+  std::sort(scratch_.begin(), scratch_.end());
+  for (uint32_t o : scratch_)
+    if (o != id && touches(box, brickBounds(grid.brick(o)))) link(id, o);
+}
+
+void BrickConnectivity::removing(uint32_t id, std::vector<uint32_t>& seeds) {
+  if (id >= adjacency_.size() || !live_[id]) return;
+  for (uint32_t n : adjacency_[id]) {
+    std::vector<uint32_t>& list = adjacency_[n];
+    list.erase(std::find(list.begin(), list.end(), id));  // keeps the list's order
+    seeds.push_back(n);
+  }
+  adjacency_[id].clear();
+  live_[id] = 0;
+}
+
+std::span<const uint32_t> BrickConnectivity::neighbours(uint32_t id) const {
+  if (id >= adjacency_.size()) return {};
+  return adjacency_[id];
+}
+
+uint32_t BrickConnectivity::find(uint32_t s) {
+  while (parent_[s] != s) s = parent_[s] = parent_[parent_[s]];
+  return s;
+}
+
+void BrickConnectivity::detached(std::span<const uint32_t> seeds, std::vector<std::vector<uint32_t>>& pieces, ConnectivityStats* stats) {
+  ConnectivityStats st;
+  // The live seeds, each once, in ascending order (the searches' order).
+  scratch_.clear();
+  for (uint32_t s : seeds)
+    if (s < live_.size() && live_[s]) scratch_.push_back(s);
+  std::sort(scratch_.begin(), scratch_.end());
+  scratch_.erase(std::unique(scratch_.begin(), scratch_.end()), scratch_.end());
+  const uint32_t k = uint32_t(scratch_.size());
+  if (k < 2) {
+    if (stats) *stats = st;
+    return;
+  }
+  if (stamp_.size() < adjacency_.size()) {
+    stamp_.resize(adjacency_.size(), 0);
+    owner_.resize(adjacency_.size(), 0);
+  }
+  if (++epoch_ == 0) {  // the stamps wrapped: clear them once
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    epoch_ = 1;
+  }
+  if (queues_.size() < k) queues_.resize(k);
+  heads_.assign(k, 0);
+  parent_.resize(k);
+  reported_.assign(k, 0);
+  for (uint32_t i = 0; i < k; ++i) {
+    parent_[i] = i;
+    queues_[i].assign(1, scratch_[i]);
+    stamp_[scratch_[i]] = epoch_;
+    owner_[scratch_[i]] = i;
+  }
+  uint32_t groups = k;  // groups of searches still growing and not reported
+  while (groups > 1) {
+    // One brick per search, in turn.
+    for (uint32_t i = 0; i < k && groups > 1; ++i) {
+      if (heads_[i] == queues_[i].size()) continue;
+      const uint32_t u = queues_[i][heads_[i]++];
+      ++st.visited;
+      for (uint32_t v : adjacency_[u]) {
+        if (stamp_[v] != epoch_) {
+          stamp_[v] = epoch_;
+          owner_[v] = i;
+          queues_[i].push_back(v);
+          continue;
+        }
+        const uint32_t a = find(i), b = find(owner_[v]);
+        if (a == b) continue;
+        parent_[std::max(a, b)] = std::min(a, b);  // the searches met: one part
+        --groups;
+      }
+    }
+    // A group whose searches have all run dry has walked a whole part: it fell off.
+    active_.assign(k, 0);
+    for (uint32_t i = 0; i < k; ++i)
+      if (heads_[i] < queues_[i].size()) active_[find(i)] = 1;
+    for (uint32_t r = 0; r < k && groups > 1; ++r) {
+      if (find(r) != r || reported_[r] || active_[r]) continue;
+      std::vector<uint32_t>& piece = pieces.emplace_back();
+      for (uint32_t i = 0; i < k; ++i)
+        if (find(i) == r) piece.insert(piece.end(), queues_[i].begin(), queues_[i].end());
+      reported_[r] = 1;
+      ++st.pieces;
+      --groups;
+    }
+  }
+  if (stats) *stats = st;
+}
+
+}  // namespace bw
