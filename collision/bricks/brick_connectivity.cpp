@@ -129,6 +129,7 @@ void BrickConnectivity::detached(std::span<const uint32_t> seeds, std::vector<st
           queues_[i].push_back(v);
           continue;
         }
+        if (owner_[v] == i) continue;  // this search's own brick (most edges)
         const uint32_t a = find(i), b = find(owner_[v]);
         if (a == b) continue;
         parent_[std::max(a, b)] = std::min(a, b);  // the searches met: one part

@@ -13,6 +13,12 @@
 //   the depth error against LOD off.
 // GridEdit/<bricks>: place + remove one brick including index and mass properties.
 // GridBuild/<bricks>: build time and bytes per brick.
+// Connectivity_RemoveNoSplit/<bricks>: one random brick of the city block removed and the grid's
+//   connectivity checked (BrickConnectivity: unlink, remove, detached()), then put back
+//   (untimed): time per removal with its distribution over the run (p50_us, p99_us, max_us),
+//   bricks visited per removal, and pieces found (removals that do split off a part count too).
+// Connectivity_CutInTwo/<bricks>: a slab of cubes in two equal halves joined by one brick:
+//   removing it detaches the half it walks; time and bricks visited per cut.
 // ConvexApprox/<build>/<depth>: hull build time, hull volume / brick volume, box or not.
 // btCompoundChunked/<shape>/<bricks>/<chunk_m>: Bullet as an expert sets it up: the grid cut
 //   into chunk_m cubes by buildBulletChunks (one shared btBoxShape / btCylinderShapeZ /
@@ -54,10 +60,13 @@
 #include <benchmark/benchmark.h>
 #include <btBulletCollisionCommon.h>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
 
+#include "collision/bricks/brick_connectivity.h"
+#include "collision/bricks/brick_geometry.h"
 #include "collision/bricks/brick_grid.h"
 #include "collision/bricks/bullet_brick_shapes.h"
 #include "collision/content/build_generators.h"
@@ -175,6 +184,78 @@ void GridEdit(benchmark::State& state) {
     g.removeBrick(id);
   }
   state.counters["us_per_edit"] = benchmark::Counter(2.0 * double(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void Connectivity_RemoveNoSplit(benchmark::State& state) {
+  // Its own copy of the city (the removals are put back, but ids may change).
+  const GeneratedBuild& b = city(uint32_t(state.range(0)));
+  BrickGrid g(BrickGrid::Config(uint32_t(b.bricks.size() + 1024)));
+  for (const Brick& br : b.bricks) g.placeBrick(br);
+  BrickConnectivity links(g);
+  std::vector<uint32_t> ids;
+  g.forEachBrick([&](uint32_t id) { ids.push_back(id); });
+  SeededRandom r(9);
+  std::vector<uint32_t> seeds;
+  std::vector<std::vector<uint32_t>> pieces;
+  std::vector<double> us;
+  uint64_t visited = 0, piecesFound = 0;
+  for (auto _ : state) {
+    const uint32_t slot = uint32_t(r.uniform(0, double(ids.size()) - 1e-9));
+    const Brick brick = g.brick(ids[slot]);
+    const auto t0 = Clock::now();
+    seeds.clear();
+    links.removing(ids[slot], seeds);
+    g.removeBrick(ids[slot]);
+    pieces.clear();
+    ConnectivityStats st;
+    links.detached(seeds, pieces, &st);
+    const double t = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+    state.SetIterationTime(t * 1e-6);
+    us.push_back(t);
+    visited += st.visited;
+    piecesFound += st.pieces;
+    // Put it back (a piece that fell off stays in the grid here: the next removals see it).
+    ids[slot] = g.placeBrick(brick);
+    links.placed(g, ids[slot]);
+  }
+  std::sort(us.begin(), us.end());
+  auto at = [&](double q) { return us.empty() ? 0.0 : us[size_t(q * double(us.size() - 1))]; };
+  state.counters["p50_us"] = at(0.5);
+  state.counters["p99_us"] = at(0.99);
+  state.counters["max_us"] = us.empty() ? 0.0 : us.back();
+  state.counters["visited_per_removal"] = double(visited) / double(std::max<int64_t>(1, state.iterations()));
+  state.counters["pieces_per_removal"] = double(piecesFound) / double(std::max<int64_t>(1, state.iterations()));
+}
+
+void Connectivity_CutInTwo(benchmark::State& state) {
+  const int side = int(std::sqrt(double(state.range(0)) / 2.0));  // two side x side halves
+  BrickGrid g(BrickGrid::Config(uint32_t(2 * side * side + 1024)));
+  for (int half = 0; half < 2; ++half)
+    for (int x = 0; x < side; ++x)
+      for (int y = 0; y < side; ++y) g.placeBrick(Brick::box(Vec3f(float(x + half * (side + 1)), float(y), 0), Vec3f::Constant(0.5f)));
+  const Brick bar = Brick::box(Vec3f(float(side), float(side / 2), 0), Vec3f::Constant(0.5f));
+  uint32_t barId = g.placeBrick(bar);
+  BrickConnectivity links(g);
+  std::vector<uint32_t> seeds;
+  std::vector<std::vector<uint32_t>> pieces;
+  uint64_t visited = 0, detached = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    seeds.clear();
+    links.removing(barId, seeds);
+    g.removeBrick(barId);
+    pieces.clear();
+    ConnectivityStats st;
+    links.detached(seeds, pieces, &st);
+    state.SetIterationTime(std::chrono::duration<double>(Clock::now() - t0).count());
+    visited += st.visited;
+    detached += pieces.empty() ? 0 : pieces[0].size();
+    barId = g.placeBrick(bar);
+    links.placed(g, barId);
+  }
+  state.counters["bricks"] = double(g.brickCount());
+  state.counters["visited_per_cut"] = double(visited) / double(std::max<int64_t>(1, state.iterations()));
+  state.counters["detached_bricks"] = double(detached) / double(std::max<int64_t>(1, state.iterations()));
 }
 
 void ConvexApprox(benchmark::State& state) {
@@ -537,6 +618,8 @@ void GridBuild(benchmark::State& state) {
 
 BENCHMARK(GridContact)->ArgsProduct({{0, 1, 2}, {10'000, 100'000, 2'000'000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(GridEdit)->Arg(100'000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(Connectivity_RemoveNoSplit)->Arg(100'000)->Arg(1'000'000)->UseManualTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(Connectivity_CutInTwo)->Arg(100'000)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(GridBuild)->Arg(10'000)->Arg(100'000)->Arg(2'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(btCompoundNaive)->Arg(10'000)->Arg(100'000)->Unit(benchmark::kMicrosecond);
 // Chunk-size sweep at 100k (2..32 m), the chosen 8 m at 10k.
