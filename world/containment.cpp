@@ -110,6 +110,13 @@ ContainmentTracker::ContainmentTracker(World& world) : world_(world) {
 const ContainmentReport& ContainmentTracker::update() {
   const BodyStore& bodies = world_.bodies();
   const uint32_t n = bodies.size();
+  // Bodies added since (parts split off grids): seen where they are, clear if outside solid.
+  for (uint32_t i = uint32_t(lastSeen_.size()); i < n; ++i) {
+    lastSeen_.push_back(bodies.position[i]);
+    lastClear_.push_back(bodies.position[i]);
+    state_.push_back(bodies.motion[i] == MotionType::Dynamic ? world_.pointInsideSolid(bodies.position[i], i) : InsideSolid::No);
+    hasClear_.push_back(bodies.motion[i] == MotionType::Dynamic && state_.back() == InsideSolid::No);
+  }
   // Pass 1, in parallel: the point test and the crossing test against grids (both only read)
   // for every body that needs a check; a crossing test against terrain (which fills chunk
   // caches) is left for pass 2.

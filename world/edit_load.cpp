@@ -59,11 +59,13 @@ uint32_t EditLoad::timedPlace(uint32_t gridIndex, BrickGrid& grid, const Brick& 
   const uint32_t id = grid.placeBrick(b);
   st.gridEditMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
   ++st.placed;
+  if (hooks_ && hooks_->afterPlace) hooks_->afterPlace(gridIndex, id);
   return id;
 }
 
 void EditLoad::timedRemove(uint32_t gridIndex, BrickGrid& grid, uint32_t id, EditLoadStats& st) {
   touched_.push_back({gridIndex, brickBounds(grid.brick(id))});
+  if (hooks_ && hooks_->beforeRemove) hooks_->beforeRemove(gridIndex, id);
   const auto t = std::chrono::steady_clock::now();
   grid.removeBrick(id);
   st.gridEditMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -167,14 +169,18 @@ void EditLoad::wall(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats&
 }
 
 EditLoadStats EditLoad::apply(uint64_t frame, const std::vector<std::unique_ptr<BrickGrid>>& grids, std::vector<uint32_t>& edited,
-                              const Blocked& blocked) {
+                              const Blocked& blocked, const Hooks& hooks) {
   EditLoadStats st;
   touched_.clear();
   blocked_ = &blocked;
+  hooks_ = &hooks;
   struct Reset {
-    const Blocked*& b;
-    ~Reset() { b = nullptr; }
-  } reset{blocked_};
+    EditLoad& load;
+    ~Reset() {
+      load.blocked_ = nullptr;
+      load.hooks_ = nullptr;
+    }
+  } reset{*this};
   for (Stream& s : streams_) {
     if (frame < s.d.firstFrame || frame > s.d.lastFrame || (frame - s.d.firstFrame) % s.d.every != 0) continue;
     BrickGrid& grid = *grids[s.grid];

@@ -44,9 +44,13 @@ class EditLoad {
   /// Whether a brick with these grid-local bounds would be built into something other than the
   /// grid (a body standing there): such spots count as taken.
   using Blocked = std::function<bool(uint32_t grid, const Aabb& localBounds)>;
+  /// Called around each brick edit (connectivity bookkeeping): before a removal, after a placement.
+  struct Hooks {
+    std::function<void(uint32_t grid, uint32_t brick)> beforeRemove, afterPlace;
+  };
   /// Applies frame `frame`'s edits; appends each grid it edited to `edited` (once per stream).
   EditLoadStats apply(uint64_t frame, const std::vector<std::unique_ptr<BrickGrid>>& grids, std::vector<uint32_t>& edited,
-                      const Blocked& blocked = {});
+                      const Blocked& blocked = {}, const Hooks& hooks = {});
   /// Whether any stream places bricks (the caller then has `blocked` answer).
   bool places() const;
   /// The grid-local bounds of every brick the last apply() placed or removed, with its grid.
@@ -87,6 +91,7 @@ class EditLoad {
   std::vector<LiveBricks> live_;   // by grid index (only edited grids fill theirs)
   std::vector<uint32_t> scratch_;  // overlap results
   const Blocked* blocked_ = nullptr;  // during apply()
+  const Hooks* hooks_ = nullptr;      // during apply()
   std::vector<std::pair<uint32_t, Aabb>> touched_;
 };
 

@@ -55,6 +55,10 @@ void World::buildGrid(const GridDescription& g) {
     if (e.grid == g.name) reserve += plannedPlacements(e, 4ull * scene_.settings.frames);
   auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(std::min<uint64_t>(reserve, 1u << 28))));
   for (const Brick& b : bricks) grid->placeBrick(b);
+  links_.push_back(g.split ? std::make_unique<BrickConnectivity>(*grid) : nullptr);
+  linksStale_.push_back(0);
+  splitSeeds_.emplace_back();
+  debrisBricks_.push_back(g.debrisBricks);
   grids_.push_back(std::move(grid));
   gridNames_.push_back(g.name);
   gridLights_.push_back(std::move(lights));

@@ -60,6 +60,11 @@ struct GridDescription {
   Quatf rotation = Quatf::Identity();
   MotionType motion = MotionType::Static;
   KinematicMotion kinematic;
+  /// Parts of the grid that a removal leaves without a face-to-face joint to the rest become
+  /// dynamic bodies of their own (BrickConnectivity); they split further in turn.
+  bool split = false;
+  /// With split: parts of fewer bricks than this vanish instead (debris), 0 keeps them all.
+  uint32_t debrisBricks = 0;
 };
 
 /// Dynamic primitives (or copies of a small grid) spawned in a box region.

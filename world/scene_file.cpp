@@ -157,7 +157,7 @@ std::string contentPath(const Field& f, const std::string& sceneSource, const ch
 
 GridDescription parseGrid(const Field& f, const std::string& sceneSource) {
   f.allowOnly({"name", "generator", "scale", "seed", "file", "tiles", "tile_gap", "bricks", "position", "rotation", "motion",
-               "linear_velocity", "angular_velocity"});
+               "linear_velocity", "angular_velocity", "split", "debris_bricks"});
   GridDescription g;
   g.name = f.at("name").string();
   if (g.name.empty()) f.at("name").fail("a non-empty name");
@@ -192,6 +192,11 @@ GridDescription parseGrid(const Field& f, const std::string& sceneSource) {
   }
   if (f.has("position")) g.position = f.at("position").vec3(-kMaxCoord, kMaxCoord);
   if (f.has("rotation")) g.rotation = f.at("rotation").quaternion();
+  if (f.has("split")) g.split = f.at("split").boolean();
+  if (f.has("debris_bricks")) {
+    g.debrisBricks = uint32_t(f.at("debris_bricks").integer(0, 1'000'000));
+    if (!g.split) f.at("debris_bricks").failMessage("applies to a grid with \"split\": true");
+  }
   if (f.has("motion")) g.motion = parseMotion(f.at("motion"));
   if (f.has("linear_velocity") || f.has("angular_velocity")) {
     if (g.motion != MotionType::Kinematic && g.motion != MotionType::Dynamic)

@@ -104,6 +104,16 @@ void validateScene(const SceneDescription& scene) {
     c.number(f + ".water_density", t.waterDensity, kMinWaterDensity, kMaxWaterDensity);
     if (t.waterFirst >= 0 && (t.waterFirst > t.waterLast || t.waterLast > 255)) c.message(f + ".water", "expected 1 <= first <= last <= 255");
   }
+  for (size_t i = 0; i < scene.grids.size(); ++i) {
+    const GridDescription& g = scene.grids[i];
+    if (!g.split) continue;
+    const std::string f = "grids[" + std::to_string(i) + "].split";
+    // note: a template's bricks are shared by every copy; which copy a removal splits is not defined.
+    for (const SpawnerDescription& sp : scene.spawners)
+      if (sp.shape == SpawnerDescription::Shape::Grid && sp.grid == g.name) c.message(f, "a grid that spawners copy cannot split");
+    if (scene.attachments.enabled)
+      c.message(f, "not with attachments yet: parts split off would have no render proxies (remove \"attachments\" or \"split\")");
+  }
   c.number("rays.length", scene.rays.length, 0, kMaxRayLength);
   for (size_t i = 0; i < scene.edits.size(); ++i) {
     const EditLoadDescription& e = scene.edits[i];

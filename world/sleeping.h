@@ -19,6 +19,11 @@ class SleepState {
  public:
   /// Every body awake, with no still time.
   void reset(uint32_t bodies);
+  /// More bodies (split off a grid): the new ones awake, the others as they were.
+  void grow(uint32_t bodies) {
+    stillTime_.resize(bodies, 0.f);
+    asleep_.resize(bodies, 0);
+  }
   bool asleep(uint32_t body) const { return asleep_[body] != 0; }
   /// Wakes the body (and restarts its still time).
   void wake(uint32_t body) {

@@ -61,6 +61,7 @@ BrickGrid& World::editGrid(uint32_t index) {
                        " grids");
   editedGrids_.push_back(index);
   wholeGridEdits_.push_back(index);  // where it is edited is not known: everything on it wakes
+  if (links_[index]) linksStale_[index] = 1;
   return *grids_[index];
 }
 
@@ -236,6 +237,94 @@ void World::applyGridEdits() {
   });
 }
 
+EditLoad::Hooks World::connectivityHooks() {
+  if (std::none_of(links_.begin(), links_.end(), [](const auto& l) { return l != nullptr; })) return {};
+  // A split grid edited through editGrid() since the last step: its links are taken again (the
+  // removals made there are not checked for parts that fell off: where they were is not known).
+  for (uint32_t g = 0; g < grids_.size(); ++g)
+    if (links_[g] && linksStale_[g]) {
+      links_[g] = std::make_unique<BrickConnectivity>(*grids_[g]);
+      linksStale_[g] = 0;
+    }
+  EditLoad::Hooks hooks;
+  hooks.beforeRemove = [this](uint32_t grid, uint32_t brick) {
+    if (!links_[grid]) return;
+    const auto t = Clock::now();
+    links_[grid]->removing(brick, splitSeeds_[grid]);
+    stats_.splitMs += msSince(t);
+  };
+  hooks.afterPlace = [this](uint32_t grid, uint32_t brick) {
+    if (!links_[grid]) return;
+    const auto t = Clock::now();
+    links_[grid]->placed(*grids_[grid], brick);
+    stats_.splitMs += msSince(t);
+  };
+  return hooks;
+}
+
+void World::splitDetachedParts() {
+  const auto t = Clock::now();
+  std::vector<std::vector<uint32_t>> parts;
+  const uint32_t count = uint32_t(grids_.size());  // parts made here split from the next frame on
+  bool any = false;
+  for (uint32_t g = 0; g < count; ++g) {
+    if (!links_[g]) continue;
+    any = true;
+    if (splitSeeds_[g].empty()) continue;
+    parts.clear();
+    links_[g]->detached(splitSeeds_[g], parts);
+    splitSeeds_[g].clear();
+    for (const std::vector<uint32_t>& part : parts) makeBodyOfPart(g, part);
+    if (!parts.empty()) wholeGridEdits_.push_back(g);  // what rested on the parts moves with them
+  }
+  if (any) stats_.splitMs += msSince(t);
+}
+
+void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
+  const uint32_t holder = gridBodies_[g].front();  // a split grid has one body (scene_validation)
+  BrickGrid& old = *grids_[g];
+  std::vector<uint32_t> ignored;
+  if (part.size() < debrisBricks_[g]) {
+    for (uint32_t id : part) {
+      links_[g]->removing(id, ignored);
+      old.removeBrick(id);
+    }
+    stats_.debrisBricks += uint32_t(part.size());
+    return;
+  }
+  // The part keeps its bricks' grid coordinates: its grid sits where the old one is.
+  auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(part.size() + 1024)));
+  for (uint32_t id : part) grid->placeBrick(old.brick(id));
+  for (uint32_t id : part) {
+    links_[g]->removing(id, ignored);
+    old.removeBrick(id);
+  }
+  // Its centre of mass moves as that point of the old body did (v + w x r about the old body's
+  // centre; a kinematic grid turns about its origin, which is its position); a static grid's
+  // parts start at rest.
+  const RigidTransform pose = bodies_.shapePose(holder);
+  const Vec3d centre = pose.pointToWorld(grid->massProperties().centerOfMass.cast<float>());
+  Vec3f v = Vec3f::Zero(), w = Vec3f::Zero();
+  if (bodies_.motion[holder] != MotionType::Static) {
+    w = bodies_.angularVelocity[holder];
+    v = bodies_.linearVelocity[holder] + w.cross((centre - bodies_.position[holder]).cast<float>());
+  }
+  const uint32_t ng = uint32_t(grids_.size());
+  links_.push_back(std::make_unique<BrickConnectivity>(*grid));
+  linksStale_.push_back(0);
+  splitSeeds_.emplace_back();
+  debrisBricks_.push_back(debrisBricks_[g]);
+  grids_.push_back(std::move(grid));
+  gridNames_.push_back(gridNames_[g] + "/part" + std::to_string(++piecesMade_));
+  gridLights_.emplace_back();
+  const uint32_t body = addGridBody(ng, pose.translation, pose.rotation, MotionType::Dynamic, v.cast<double>(), w);
+  gridBodies_.push_back({body});
+  solidBodies_.push_back(body);
+  nearSolid_.push_back(1);
+  sleep_.grow(bodies_.size());
+  ++stats_.splits;
+}
+
 EditLoad::Blocked World::editBlockers() {
   if (!editLoad_.places()) return {};
   // Every dynamic body's box now (its bounds over the coming frame's motion); a planned brick is
@@ -292,13 +381,14 @@ void World::step() {
     ProfileZone z(profiler_, "edits", kEditStage, true);
     if (!editLoad_.empty()) {
       const auto load = Clock::now();
-      const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_, editBlockers());
+      const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_, editBlockers(), connectivityHooks());
       stats_.bricksRemoved = e.removed;
       stats_.bricksPlaced = e.placed;
       stats_.editsSkipped = e.skipped;
       stats_.editMs = e.gridEditMs;
       stats_.editLoadMs = msSince(load) - e.gridEditMs;
     }
+    splitDetachedParts();
     const auto apply = Clock::now();
     const bool edited = !editedGrids_.empty();
     applyGridEdits();

@@ -35,6 +35,7 @@
 #include "world/containment.h"
 #include "world/contact_solver.h"
 #include "world/depenetration.h"
+#include "collision/bricks/brick_connectivity.h"
 #include "world/body_box_index.h"
 #include "world/edit_load.h"
 #include "world/islands.h"
@@ -67,6 +68,9 @@ struct StepStats {
   double editLoadMs = 0;         ///< the scene's edit load choosing what to edit (random picks, free-spot checks)
   uint32_t bricksRemoved = 0, bricksPlaced = 0;  ///< by the scene's edit load this frame
   uint32_t editsSkipped = 0;     ///< edit load placements with no free spot (or removals of nothing)
+  uint32_t splits = 0;           ///< parts split off grids into bodies of their own this frame
+  uint32_t debrisBricks = 0;     ///< bricks of parts below a grid's debris_bricks, gone this frame
+  double splitMs = 0;            ///< connectivity upkeep and checks, and making the split parts' bodies
 };
 
 class World {
@@ -213,6 +217,11 @@ class World {
   void applyGridEdits();
   /// What the edit load must not build into: the dynamic bodies (none if it places nothing).
   EditLoad::Blocked editBlockers();
+  /// The edit load's hooks keeping split grids' connectivity (none without such grids).
+  EditLoad::Hooks connectivityHooks();
+  /// Parts the frame's removals detached from split grids become dynamic bodies (or vanish).
+  void splitDetachedParts();
+  void makeBodyOfPart(uint32_t grid, const std::vector<uint32_t>& part);
   /// A dynamic grid body's mass, centre of mass and inertia after its grid was edited.
   void refreshGridBodyMass(uint32_t body);
   // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
@@ -284,6 +293,13 @@ class World {
   std::vector<uint32_t> wholeGridEdits_;  // of those, the ones handed out by editGrid()
   BodyBoxIndex editedBoxes_;           // the edit load's bricks of this frame, in the world
   EditLoad editLoad_;                  // the scene's edits, applied at the start of each step
+  // Grids that split (GridDescription::split): per grid, its connectivity (null: does not split),
+  // the removed bricks' neighbours of this frame, and its debris threshold.
+  std::vector<std::unique_ptr<BrickConnectivity>> links_;
+  std::vector<uint8_t> linksStale_;    // per grid: edited through editGrid() (links_ not kept)
+  std::vector<std::vector<uint32_t>> splitSeeds_;
+  std::vector<uint32_t> debrisBricks_;
+  uint32_t piecesMade_ = 0;
   BodyBoxIndex editBodies_;            // dynamic bodies' boxes, built when the edit load places bricks
   std::vector<std::vector<uint32_t>> gridBodies_;  // per grid: the bodies holding it (built once)
   // The edits' profiling stage: one serial stage before the substeps' (they run first), below

@@ -178,7 +178,8 @@ int runScene(const SceneRunOptions& o) {
 
   Series total, broad, contacts, solver, integrate, rays, edits;
   uint64_t pairs = 0, contactCount = 0, boxTests = 0, reused = 0, rayCount = 0, rayHits = 0, rayBoxTests = 0, terrainContacts = 0;
-  uint64_t removed = 0, placed = 0, editSkipped = 0;
+  uint64_t removed = 0, placed = 0, editSkipped = 0, splits = 0, debris = 0;
+  Series splitTimes;
   double editMsTotal = 0, editLoadMsTotal = 0;
   uint32_t floating = 0, largestIsland = 0, splitIslands = 0;
   std::ofstream csv;
@@ -218,6 +219,9 @@ int runScene(const SceneRunOptions& o) {
     removed += s.bricksRemoved;
     placed += s.bricksPlaced;
     editSkipped += s.editsSkipped;
+    splits += s.splits;
+    debris += s.debrisBricks;
+    splitTimes.v.push_back(s.splitMs);
     if (world.render()) render.add(s.render);
     rayCount += s.rays;
     rayHits += s.rayHits;
@@ -313,6 +317,9 @@ int runScene(const SceneRunOptions& o) {
       j["edits_skipped_per_frame"] = double(editSkipped) / frames;
       j["edit_us_per_brick"] = removed + placed ? 1e3 * editMsTotal / double(removed + placed) : 0.0;
       j["edit_load_choosing_ms_per_frame"] = editLoadMsTotal / frames;
+      j["splits"] = splits;
+      j["debris_bricks"] = debris;
+      j["split"] = stage(splitTimes);
     }
     if (rayCount) {
       j["rays"] = stage(rays);
@@ -359,6 +366,9 @@ int runScene(const SceneRunOptions& o) {
                 "wakes, caches); the load's own choosing %.3f ms per frame, outside the edit times\n",
                 double(removed) / frames, double(placed) / frames, double(editSkipped) / frames,
                 removed + placed ? 1e3 * editMsTotal / double(removed + placed) : 0.0, editLoadMsTotal / frames);
+  if (!scene.edits.empty() && (splits || debris || splitTimes.max() > 0))
+    std::printf("  splits: %llu parts became bodies, %llu debris bricks gone; connectivity and splitting %.3f ms median, %.3f ms max a frame\n",
+                (unsigned long long)splits, (unsigned long long)debris, splitTimes.quantile(0.5), splitTimes.max());
   if (!scene.terrains.empty())
     std::printf("  terrain: %.0f contacts per frame, %u bodies in water at the end\n", double(terrainContacts) / frames, floating);
   std::printf("  dynamic bodies at the end: %u resting (%u asleep), %u moving, lowest at z = %.2f\n", resting,
