@@ -65,6 +65,33 @@ BrickGrid& World::editGrid(uint32_t index) {
   return *grids_[index];
 }
 
+World::RemovalResult World::removeBricks(uint32_t index, std::span<const uint32_t> bricks) {
+  const auto t = Clock::now();
+  if (index >= grids_.size())
+    throw InvalidInput("World::removeBricks: index is " + std::to_string(index) + ", the world has " + std::to_string(grids_.size()) +
+                       " grids");
+  BrickGrid& grid = *grids_[index];
+  for (uint32_t id : bricks)
+    if (!grid.hasBrick(id))
+      throw InvalidInput("World::removeBricks: brick " + std::to_string(id) + " is not in grid " + std::to_string(index) + " ('" +
+                         gridNames_[index] + "')");
+  // note: a brick listed twice is removed once (checked above while all were live).
+  for (uint32_t id : bricks) {
+    if (!grid.hasBrick(id)) continue;
+    if (links_[index] && !linksStale_[index]) links_[index]->removing(id, splitSeeds_[index]);
+    grid.removeBrick(id);
+  }
+  editedGrids_.push_back(index);
+  wholeGridEdits_.push_back(index);
+  const StepStats kept = stats_;
+  stats_.splits = stats_.debrisBricks = 0;
+  splitDetachedParts();
+  RemovalResult r{stats_.splits, stats_.debrisBricks, 0.0};
+  stats_ = kept;  // the last step's figures stay as they were
+  r.ms = msSince(t);
+  return r;
+}
+
 uint64_t World::brickCount() const {
   uint64_t n = 0;
   for (const auto& g : grids_) n += g->brickCount();
@@ -294,7 +321,11 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   }
   // The part keeps its bricks' grid coordinates: its grid sits where the old one is.
   auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(part.size() + 1024)));
-  for (uint32_t id : part) grid->placeBrick(old.brick(id));
+  std::vector<Brick> bricks;
+  bricks.reserve(part.size());
+  for (uint32_t id : part) bricks.push_back(old.brick(id));
+  const std::vector<uint32_t> ids = grid->placeBricks(bricks);  // the index in one pass
+  auto partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   for (uint32_t id : part) {
     links_[g]->removing(id, ignored);
     old.removeBrick(id);
@@ -310,7 +341,7 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
     v = bodies_.linearVelocity[holder] + w.cross((centre - bodies_.position[holder]).cast<float>());
   }
   const uint32_t ng = uint32_t(grids_.size());
-  links_.push_back(std::make_unique<BrickConnectivity>(*grid));
+  links_.push_back(std::move(partLinks));
   linksStale_.push_back(0);
   splitSeeds_.emplace_back();
   debrisBricks_.push_back(debrisBricks_[g]);

@@ -22,6 +22,7 @@
 /// at a time; editGrid() and probeContacts() only between steps.
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "collision/bricks/brick_grid.h"
@@ -109,6 +110,17 @@ class World {
   /// its cached contacts are dropped; a dynamic body using it takes the grid's new mass, centre
   /// of mass and inertia, every remaining brick keeping its velocity. Not while step() runs.
   BrickGrid& editGrid(uint32_t index);
+  /// What removeBricks did.
+  struct RemovalResult {
+    uint32_t parts = 0;         ///< parts split off into dynamic bodies
+    uint32_t debrisBricks = 0;  ///< bricks of parts below the grid's debris_bricks, gone
+    double ms = 0;              ///< from the first removal to the parts' bodies made
+  };
+  /// Removes bricks of grid `index` between steps, as a game's demolition does; on a grid that
+  /// splits (GridDescription::split) the parts left without a face joint become dynamic bodies
+  /// right away (their ids follow the others'). Bodies on the grid wake, as with editGrid().
+  /// InvalidInput (nothing removed) for a bad grid index or a brick id not in the grid.
+  RemovalResult removeBricks(uint32_t index, std::span<const uint32_t> bricks);
   /// Hash of every body's position, rotation and velocities (bit patterns): equal hashes mean
   /// bit-identical states. The same for any thread count.
   uint64_t stateHash() const;

@@ -1,8 +1,10 @@
 #include "collision/bricks/brick_connectivity.h"
 
 #include <algorithm>
+#include <string>
 
 #include "collision/bricks/brick_geometry.h"
+#include "collision/core/argument_checks.h"
 
 namespace bw {
 
@@ -40,6 +42,26 @@ BrickConnectivity::BrickConnectivity(const BrickGrid& grid) {
     for (uint32_t o : scratch_)
       if (o > id && touches(box, brickBounds(grid.brick(o)))) link(id, o);
   });
+}
+
+BrickConnectivity::BrickConnectivity(const BrickConnectivity& from, std::span<const uint32_t> oldIds, std::span<const uint32_t> newIds) {
+  if (oldIds.size() != newIds.size())
+    throw InvalidInput("BrickConnectivity: " + std::to_string(oldIds.size()) + " old ids for " + std::to_string(newIds.size()) + " new ones");
+  uint32_t top = 0;
+  for (uint32_t id : newIds) top = std::max(top, id + 1);
+  adjacency_.resize(top);
+  live_.assign(top, 0);
+  // Old id -> new id, through a map sized by the old ids (only the part's entries are read).
+  std::vector<uint32_t> renumber(from.adjacency_.size(), ~0u);
+  for (size_t k = 0; k < oldIds.size(); ++k) renumber.at(oldIds[k]) = newIds[k];
+  for (size_t k = 0; k < oldIds.size(); ++k) {
+    std::vector<uint32_t>& list = adjacency_[newIds[k]];
+    for (uint32_t n : from.adjacency_[oldIds[k]]) {
+      if (renumber[n] == ~0u) throw InvalidInput("BrickConnectivity: brick " + std::to_string(oldIds[k]) + " has a neighbour outside the part");
+      list.push_back(renumber[n]);
+    }
+    live_[newIds[k]] = 1;
+  }
 }
 
 void BrickConnectivity::link(uint32_t a, uint32_t b) {

@@ -47,6 +47,11 @@ class BrickConnectivity {
   /// Every brick's neighbours (one overlap query per brick).
   explicit BrickConnectivity(const BrickGrid& grid);
 
+  /// A part that detached() reported, moved into a grid of its own: its links are the old
+  /// ones (a detached part has no neighbour outside itself), renumbered from oldIds[k] to
+  /// newIds[k], with no query of the new grid. Call before the part's removing() calls.
+  BrickConnectivity(const BrickConnectivity& from, std::span<const uint32_t> oldIds, std::span<const uint32_t> newIds);
+
   /// Whether two bricks' bounds touch face to face (or overlap).
   static bool touches(const Aabb& a, const Aabb& b);
 

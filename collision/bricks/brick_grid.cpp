@@ -6,6 +6,7 @@
 #include <string>
 
 #include "collision/core/argument_checks.h"
+#include "collision/core/errors.h"
 
 namespace bw {
 
@@ -48,6 +49,40 @@ uint32_t BrickGrid::placeBrick(const Brick& b) {
   moments_ += brickMoments(b, config_.density[b.material], reference_);
   ++edits_;
   return id;
+}
+
+std::vector<uint32_t> BrickGrid::placeBricks(const std::vector<Brick>& bricks) {
+  if (bricks_.size() != 0) throw InvalidInput("BrickGrid::placeBricks: the grid must be empty (it has " + std::to_string(bricks_.size()) + " bricks)");
+  if (bricks.size() > config_.maxBricks)
+    throw CapacityExceeded("BrickGrid::placeBricks: " + std::to_string(bricks.size()) + " bricks exceed the grid's capacity of " +
+                           std::to_string(config_.maxBricks));
+  std::vector<Aabb> bounds;
+  std::vector<uint32_t> filters, ids;
+  bounds.reserve(bricks.size());
+  for (const Brick& b : bricks) {
+    validateBrick(b, "BrickGrid::placeBricks");
+    bounds.push_back(brickBounds(b));
+    filters.push_back(b.filter);
+  }
+  for (size_t i = 0; i < bricks.size(); ++i) ids.push_back(bricks_.allocate());
+  std::vector<uint32_t> elements;
+  try {
+    elements = index_.bulkLoad(bounds, filters, ids);  // validates every box before building
+  } catch (...) {
+    for (uint32_t id : ids) bricks_.free(id);
+    throw;
+  }
+  for (size_t i = 0; i < bricks.size(); ++i) {
+    bricks_.get<0>(ids[i]) = bricks[i];
+    bricks_.get<1>(ids[i]) = elements[i];
+    if (!referenceSet_) {
+      reference_ = bricks[i].position.cast<double>();  // as placeBrick: moments about the first brick
+      referenceSet_ = true;
+    }
+    moments_ += brickMoments(bricks[i], config_.density[bricks[i].material], reference_);
+  }
+  ++edits_;
+  return ids;
 }
 
 void BrickGrid::removeBrick(uint32_t id) {

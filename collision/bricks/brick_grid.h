@@ -104,6 +104,12 @@ class BrickGrid {
   uint32_t placeBrick(const Brick& b);
   /// Removes a brick by id (InvalidInput for an unknown id).
   void removeBrick(uint32_t id);
+  /// Places many bricks into an empty grid at once (the index built in one pass: the same tree
+  /// structure, ids and mass properties as placing them one by one, though its elements are
+  /// numbered in another order, so queries may list the same bricks in another order); returns
+  /// their ids in order.
+  /// Throws InvalidInput (a bad brick, a grid not empty) or CapacityExceeded, placing nothing.
+  std::vector<uint32_t> placeBricks(const std::vector<Brick>& bricks);
   /// Counts edits; caches keyed on it are stale when it changes.
   uint64_t editCount() const { return edits_; }
 

@@ -2,6 +2,10 @@
 //
 //   build/release/bin/bench_world --benchmark_counters_tabular=true
 //
+// Split_CutInTwo/<bricks>: issue 18's cut: a static slab of cubes in two equal halves joined by
+//   one brick, split on; World::removeBricks of that brick, timed from the removal to the
+//   detached half's dynamic body made (connectivity search, its grid built in one pass, the
+//   bricks taken out of the old grid, the body added). Counters: parts, detached_bricks.
 // Broadphase/<method>/<n>/iterations:<frames>/manual_time: issue 17's question, which
 // broadphase at 1k, 10k, 100k and 1M bodies. n moving 0.5 m boxes fall onto huge static grids
 // (400 x 400 x 40 m boxes, the shape of the shipped scenes), moved every frame (velocities flip
@@ -83,6 +87,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "collision/core/seeded_random.h"
@@ -591,9 +596,40 @@ void printWorldRatios() {
 }
 
 
+void Split_CutInTwo(benchmark::State& state) {
+  const int side = int(std::sqrt(double(state.range(0)) / 2.0));
+  SceneDescription scene;
+  scene.name = "cut";
+  GridDescription slab;
+  slab.name = "slab";
+  slab.split = true;
+  for (int half = 0; half < 2; ++half)
+    for (int x = 0; x < side; ++x)
+      for (int y = 0; y < side; ++y) slab.bricks.push_back(Brick::box(Vec3f(float(x + half * (side + 1)), float(y), 0), Vec3f::Constant(0.5f)));
+  slab.bricks.push_back(Brick::box(Vec3f(float(side), float(side / 2), 0), Vec3f::Constant(0.5f)));  // the joint, last
+  scene.grids = {slab};
+  uint32_t parts = 0, detached = 0;
+  for (auto _ : state) {
+    World world(scene, 1);  // each cut needs the slab whole again (not timed)
+    const uint32_t joint = uint32_t(slab.bricks.size() - 1);
+    if (!world.grid(0).hasBrick(joint) || world.grid(0).brick(joint).position != slab.bricks.back().position) {
+      state.SkipWithError("the joint's brick id is not the last one");
+      return;
+    }
+    const World::RemovalResult r = world.removeBricks(0, std::span<const uint32_t>(&joint, 1));
+    state.SetIterationTime(r.ms * 1e-3);
+    parts = r.parts;
+    detached = world.bodies().size() > 1 ? world.grid(1).brickCount() : 0;
+  }
+  state.counters["bricks"] = double(slab.bricks.size());
+  state.counters["parts"] = parts;
+  state.counters["detached_bricks"] = detached;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  benchmark::RegisterBenchmark("Split_CutInTwo", Split_CutInTwo)->Arg(100'000)->Iterations(5)->UseManualTime()->Unit(benchmark::kMillisecond);
   // Broadphase rows: per method, every body count; the same frames (iterations) for every method.
   const auto add = [](const std::string& name, uint32_t n, void (*fn)(benchmark::State&)) {
     benchmark::RegisterBenchmark(name.c_str(), fn)->Arg(n)->Iterations(framesFor(n))->UseManualTime()->Unit(benchmark::kMillisecond);

@@ -431,5 +431,31 @@ TEST(EditLoadSplit, SplitGridsAreRefusedWhereASplitIsUndefined) {
                SceneError);
 }
 
+TEST(EditLoadSplit, RemoveBricksSplitsAtOnceAndRefusesBadIdsWhole) {
+  const SceneDescription scene = parseScene(R"({
+    "name": "bar", "settings": {"frames": 10},
+    "grids": [{"name": "bar", "bricks": [
+      {"position": [0, 0, 5], "half_size": [0.5, 0.5, 0.5]}, {"position": [1, 0, 5], "half_size": [0.5, 0.5, 0.5]},
+      {"position": [2, 0, 5], "half_size": [0.5, 0.5, 0.5]}, {"position": [3, 0, 5], "half_size": [0.5, 0.5, 0.5]},
+      {"position": [4, 0, 5], "half_size": [0.5, 0.5, 0.5]}], "split": true}]})",
+                                          "bar.json");
+  World world(scene, 1);
+  const uint32_t bad[] = {1, 77};
+  EXPECT_THROW(world.removeBricks(0, bad), InvalidInput);
+  EXPECT_EQ(world.grid(0).brickCount(), 5u) << "nothing removed";
+  EXPECT_THROW(world.removeBricks(3, bad), InvalidInput);
+  const uint32_t middle[] = {1};  // x = 1: the brick at x = 0 falls off
+  const World::RemovalResult r = world.removeBricks(0, middle);
+  EXPECT_EQ(r.parts, 1u);
+  ASSERT_EQ(world.bodies().size(), 2u);
+  EXPECT_EQ(world.grid(0).brickCount() + world.grid(1).brickCount(), 4u);
+  EXPECT_EQ(world.grid(1).brickCount(), 1u) << "the smaller side is the part";
+  EXPECT_EQ(world.bodies().motion[1], MotionType::Dynamic);
+  EXPECT_LT(world.bodies().position[1].x(), 0.01);
+  for (int f = 0; f < 30; ++f) world.step();
+  EXPECT_LT(world.bodies().position[1].z(), 5.0 - 1.0) << "a static grid's part falls";
+  EXPECT_DOUBLE_EQ(world.bodies().position[0].z(), 0.0) << "the grid stays";
+}
+
 }  // namespace
 }  // namespace bw

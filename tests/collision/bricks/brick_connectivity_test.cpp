@@ -154,7 +154,16 @@ TEST(BrickConnectivity, DetachedPiecesAreExactlyTheComponentsThatLeftTheRest) {
         ASSERT_EQ(set.size(), piece.size()) << "a brick twice in one piece";
         ASSERT_EQ(byLabel.at(label.at(piece[0])), set) << "a piece is not a whole component";
       }
-      // The pieces leave the grid (as the world moves them into bodies of their own).
+      // The pieces leave the grid (as the world moves them into bodies of their own), their
+      // links carried over renumbered: the brute-force adjacency of their own grid.
+      for (const std::vector<uint32_t>& piece : pieces) {
+        BrickGrid part(BrickGrid::Config(uint32_t(piece.size() + 16)));
+        std::vector<Brick> bricks;
+        for (uint32_t id : piece) bricks.push_back(grid->brick(id));
+        const std::vector<uint32_t> ids = part.placeBricks(bricks);
+        const BrickConnectivity partLinks(links, piece, ids);
+        expectAdjacencyIsBruteForce(part, partLinks);
+      }
       for (const std::vector<uint32_t>& piece : pieces)
         for (uint32_t id : piece) {
           std::vector<uint32_t> ignored;

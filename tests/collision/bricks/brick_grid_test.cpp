@@ -6,6 +6,7 @@
 
 #include "collision/bricks/brick_grid.h"
 #include "collision/core/argument_checks.h"
+#include "collision/core/errors.h"
 #include "collision/core/seeded_random.h"
 
 namespace bw {
@@ -391,6 +392,42 @@ TEST(BrickGrid, BadBricksAndQueriesAreRejectedWithoutChanges) {
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("brick.halfSize.y"), std::string::npos) << e.what();
   }
+}
+
+// placeBricks (a part split off a grid, a scene's build) against placing the same bricks one
+// by one: the same ids, tree, mass properties and answers; refused whole when it cannot place all.
+TEST(BrickGrid, PlacingManyAtOnceEqualsPlacingThemOneByOne) {
+  for (const Vec3f offset : {Vec3f(0, 0, 0), Vec3f(3.0e4f, -2.0e4f, 500.f)}) {
+    const std::vector<Brick> bricks = randomBuild(17, 3000, offset);
+    BrickGrid one, many;
+    std::vector<uint32_t> oneIds;
+    for (const Brick& b : bricks) oneIds.push_back(one.placeBrick(b));
+    const std::vector<uint32_t> manyIds = many.placeBricks(bricks);
+    EXPECT_EQ(manyIds, oneIds);
+    EXPECT_EQ(many.index().structureHash(), one.index().structureHash());
+    const MassProperties a = one.massProperties(), b = many.massProperties();
+    EXPECT_EQ(a.mass, b.mass);
+    EXPECT_EQ(a.centerOfMass, b.centerOfMass);
+    EXPECT_EQ(a.inertia, b.inertia);
+    std::vector<uint32_t> hitsA, hitsB;
+    const Aabb probe{offset + Vec3f(3, 3, 3), offset + Vec3f(9, 9, 9)};
+    one.overlapBricks(probe, ~0u, hitsA);
+    many.overlapBricks(probe, ~0u, hitsB);
+    std::sort(hitsA.begin(), hitsA.end());
+    std::sort(hitsB.begin(), hitsB.end());
+    EXPECT_EQ(hitsA, hitsB);
+    EXPECT_FALSE(hitsA.empty());
+  }
+  BrickGrid grid;
+  std::vector<Brick> bad = randomBuild(3, 10, Vec3f::Zero());
+  bad[7].halfSize.y() = -1.f;
+  EXPECT_THROW(grid.placeBricks(bad), InvalidInput);
+  EXPECT_EQ(grid.brickCount(), 0u);
+  grid.placeBrick(randomBuild(3, 1, Vec3f::Zero())[0]);
+  EXPECT_THROW(grid.placeBricks(randomBuild(4, 5, Vec3f::Zero())), InvalidInput) << "not empty";
+  BrickGrid small(BrickGrid::Config(4));
+  EXPECT_THROW(small.placeBricks(randomBuild(5, 9, Vec3f::Zero())), CapacityExceeded);
+  EXPECT_EQ(small.brickCount(), 0u);
 }
 
 }  // namespace
