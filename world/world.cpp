@@ -242,7 +242,8 @@ void World::applyGridEdits() {
   }
   editedBoxes_.build(std::move(boxes), std::move(owners));
   auto touchesEdit = [&](const BodyPair& p) {
-    for (auto [g, other] : {std::pair{p.a, p.b}, std::pair{p.b, p.a}}) {
+    for (const auto& side : {std::pair{p.a, p.b}, std::pair{p.b, p.a}}) {
+      const uint32_t g = side.first, other = side.second;  // note: not a structured binding (clang 14 cannot capture one)
       if (!bodies_.shape[g].isGrid() || !edited[bodies_.shape[g].grid]) continue;
       if (edited[bodies_.shape[g].grid] == 2) return true;
       float reach;
@@ -417,7 +418,7 @@ void World::step() {
       stats_.bricksPlaced = e.placed;
       stats_.editsSkipped = e.skipped;
       stats_.editMs = e.gridEditMs;
-      stats_.editLoadMs = msSince(load) - e.gridEditMs;
+      stats_.editLoadMs = msSince(load) - e.gridEditMs - stats_.splitMs;  // the connectivity hooks are split time
     }
     splitDetachedParts();
     const auto apply = Clock::now();
