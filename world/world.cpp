@@ -75,10 +75,11 @@ World::RemovalResult World::removeBricks(uint32_t index, std::span<const uint32_
     if (!grid.hasBrick(id))
       throw InvalidInput("World::removeBricks: brick " + std::to_string(id) + " is not in grid " + std::to_string(index) + " ('" +
                          gridNames_[index] + "')");
+  refreshStaleLinks();
   // note: a brick listed twice is removed once (checked above while all were live).
   for (uint32_t id : bricks) {
     if (!grid.hasBrick(id)) continue;
-    if (links_[index] && !linksStale_[index]) links_[index]->removing(id, splitSeeds_[index]);
+    if (links_[index]) links_[index]->removing(id, splitSeeds_[index]);
     grid.removeBrick(id);
   }
   editedGrids_.push_back(index);
@@ -265,15 +266,18 @@ void World::applyGridEdits() {
   });
 }
 
-EditLoad::Hooks World::connectivityHooks() {
-  if (std::none_of(links_.begin(), links_.end(), [](const auto& l) { return l != nullptr; })) return {};
-  // A split grid edited through editGrid() since the last step: its links are taken again (the
-  // removals made there are not checked for parts that fell off: where they were is not known).
+void World::refreshStaleLinks() {
+  // A split grid edited through editGrid(): its links are taken again (the removals made there
+  // are not checked for parts that fell off: where they were is not known).
   for (uint32_t g = 0; g < grids_.size(); ++g)
     if (links_[g] && linksStale_[g]) {
       links_[g] = std::make_unique<BrickConnectivity>(*grids_[g]);
       linksStale_[g] = 0;
     }
+}
+
+EditLoad::Hooks World::connectivityHooks() {
+  if (std::none_of(links_.begin(), links_.end(), [](const auto& l) { return l != nullptr; })) return {};
   EditLoad::Hooks hooks;
   hooks.beforeRemove = [this](uint32_t grid, uint32_t brick) {
     if (!links_[grid]) return;
@@ -411,6 +415,7 @@ void World::step() {
   profiler_.beginFrame(frame_);
   {
     ProfileZone z(profiler_, "edits", kEditStage, true);
+    refreshStaleLinks();
     if (!editLoad_.empty()) {
       const auto load = Clock::now();
       const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_, editBlockers(), connectivityHooks());

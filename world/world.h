@@ -229,6 +229,8 @@ class World {
   void applyGridEdits();
   /// What the edit load must not build into: the dynamic bodies (none if it places nothing).
   EditLoad::Blocked editBlockers();
+  /// Split grids edited through editGrid() get their connectivity taken again.
+  void refreshStaleLinks();
   /// The edit load's hooks keeping split grids' connectivity (none without such grids).
   EditLoad::Hooks connectivityHooks();
   /// Parts the frame's removals detached from split grids become dynamic bodies (or vanish).

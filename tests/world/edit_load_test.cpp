@@ -455,6 +455,11 @@ TEST(EditLoadSplit, RemoveBricksSplitsAtOnceAndRefusesBadIdsWhole) {
   for (int f = 0; f < 30; ++f) world.step();
   EXPECT_LT(world.bodies().position[1].z(), 5.0 - 1.0) << "a static grid's part falls";
   EXPECT_DOUBLE_EQ(world.bodies().position[0].z(), 0.0) << "the grid stays";
+  // After an edit through editGrid() (which the links do not see), removals still split.
+  world.editGrid(0).placeBrick(Brick::box(Vec3f(5, 0, 5), Vec3f::Constant(0.5f)));  // x = 2, 3, 4, 5
+  const uint32_t second[] = {3};  // x = 3 goes: x = 2 falls off (the smaller side)
+  EXPECT_EQ(world.removeBricks(0, second).parts, 1u);
+  EXPECT_EQ(world.bodies().size(), 3u);
 }
 
 }  // namespace
