@@ -77,8 +77,10 @@ World::RemovalResult World::removeBricks(uint32_t index, std::span<const uint32_
                          gridNames_[index] + "')");
   refreshStaleLinks();
   // note: a brick listed twice is removed once (checked above while all were live).
+  editLog_.clear();
   for (uint32_t id : bricks) {
     if (!grid.hasBrick(id)) continue;
+    if (recordingEdits_) editLog_.bricks.push_back({index, id, false, grid.brick(id)});
     if (links_[index]) links_[index]->removing(id, splitSeeds_[index]);
     grid.removeBrick(id);
   }
@@ -276,22 +278,30 @@ void World::refreshStaleLinks() {
     }
 }
 
-EditLoad::Hooks World::connectivityHooks() {
-  if (std::none_of(links_.begin(), links_.end(), [](const auto& l) { return l != nullptr; })) return {};
+EditLoad::Hooks World::editHooks() {
+  const bool linked = std::any_of(links_.begin(), links_.end(), [](const auto& l) { return l != nullptr; });
+  if (!linked && !recordingEdits_) return {};
   EditLoad::Hooks hooks;
   hooks.beforeRemove = [this](uint32_t grid, uint32_t brick) {
+    if (recordingEdits_) editLog_.bricks.push_back({grid, brick, false, grids_[grid]->brick(brick)});
     if (!links_[grid]) return;
     const auto t = Clock::now();
     links_[grid]->removing(brick, splitSeeds_[grid]);
     stats_.splitMs += msSince(t);
   };
   hooks.afterPlace = [this](uint32_t grid, uint32_t brick) {
+    if (recordingEdits_) editLog_.bricks.push_back({grid, brick, true, grids_[grid]->brick(brick)});
     if (!links_[grid]) return;
     const auto t = Clock::now();
     links_[grid]->placed(*grids_[grid], brick);
     stats_.splitMs += msSince(t);
   };
   return hooks;
+}
+
+void World::recordEdits(bool on) {
+  recordingEdits_ = on;
+  editLog_.clear();
 }
 
 void World::splitDetachedParts() {
@@ -306,7 +316,9 @@ void World::splitDetachedParts() {
     parts.clear();
     links_[g]->detached(splitSeeds_[g], parts);
     splitSeeds_[g].clear();
+    const auto made = Clock::now();
     for (const std::vector<uint32_t>& part : parts) makeBodyOfPart(g, part);
+    if (!parts.empty()) stats_.partBodiesMs += msSince(made);
     if (!parts.empty()) wholeGridEdits_.push_back(g);  // what rested on the parts moves with them
   }
   if (any) stats_.splitMs += msSince(t);
@@ -318,6 +330,7 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   std::vector<uint32_t> ignored;
   if (part.size() < debrisBricks_[g]) {
     for (uint32_t id : part) {
+      if (recordingEdits_) editLog_.bricks.push_back({g, id, false, old.brick(id)});
       links_[g]->removing(id, ignored);
       old.removeBrick(id);
     }
@@ -332,6 +345,7 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   const std::vector<uint32_t> ids = grid->placeBricks(bricks);  // the index in one pass
   auto partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   for (uint32_t id : part) {
+    if (recordingEdits_) editLog_.bricks.push_back({g, id, false, old.brick(id)});
     links_[g]->removing(id, ignored);
     old.removeBrick(id);
   }
@@ -358,6 +372,7 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   solidBodies_.push_back(body);
   nearSolid_.push_back(1);
   sleep_.grow(bodies_.size());
+  if (recordingEdits_) editLog_.splits.push_back({g, ng, body});
   ++stats_.splits;
 }
 
@@ -408,29 +423,40 @@ void World::refreshGridBodyMass(uint32_t body) {
   sleep_.wake(body);
 }
 
+void World::runEdits() {
+  ProfileZone z(profiler_, "edits", kEditStage, true);
+  editLog_.clear();
+  refreshStaleLinks();
+  if (!editLoad_.empty()) {
+    const auto load = Clock::now();
+    const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_, editBlockers(), editHooks());
+    stats_.bricksRemoved = e.removed;
+    stats_.bricksPlaced = e.placed;
+    stats_.editsSkipped = e.skipped;
+    stats_.editMs = e.gridEditMs;
+    stats_.editLoadMs = msSince(load) - e.gridEditMs - stats_.splitMs;  // the connectivity hooks are split time
+  }
+  splitDetachedParts();
+  const auto apply = Clock::now();
+  const bool edited = !editedGrids_.empty();
+  applyGridEdits();
+  if (edited) stats_.editMs += msSince(apply);
+}
+
+void World::applyFrameEdits() {
+  stats_ = StepStats{};
+  profiler_.beginFrame(frame_);
+  runEdits();
+  profiler_.endFrame();
+  ++frame_;
+}
+
 void World::step() {
   const auto t = Clock::now();
   stats_ = StepStats{};
   nearSolid_.assign(bodies_.size(), 0);
   profiler_.beginFrame(frame_);
-  {
-    ProfileZone z(profiler_, "edits", kEditStage, true);
-    refreshStaleLinks();
-    if (!editLoad_.empty()) {
-      const auto load = Clock::now();
-      const EditLoadStats e = editLoad_.apply(frame_, grids_, editedGrids_, editBlockers(), connectivityHooks());
-      stats_.bricksRemoved = e.removed;
-      stats_.bricksPlaced = e.placed;
-      stats_.editsSkipped = e.skipped;
-      stats_.editMs = e.gridEditMs;
-      stats_.editLoadMs = msSince(load) - e.gridEditMs - stats_.splitMs;  // the connectivity hooks are split time
-    }
-    splitDetachedParts();
-    const auto apply = Clock::now();
-    const bool edited = !editedGrids_.empty();
-    applyGridEdits();
-    if (edited) stats_.editMs += msSince(apply);
-  }
+  runEdits();
   advanceDepenetration();
   const float dt = float(scene_.settings.timestep / scene_.settings.substeps);
   for (int s = 0; s < scene_.settings.substeps; ++s) substep(dt, s);

@@ -39,6 +39,7 @@
 #include "collision/bricks/brick_connectivity.h"
 #include "world/body_box_index.h"
 #include "world/edit_load.h"
+#include "world/edit_log.h"
 #include "world/islands.h"
 #include "world/pair_cache.h"
 #include "world/ray_load.h"
@@ -72,6 +73,7 @@ struct StepStats {
   uint32_t splits = 0;           ///< parts split off grids into bodies of their own this frame
   uint32_t debrisBricks = 0;     ///< bricks of parts below a grid's debris_bricks, gone this frame
   double splitMs = 0;            ///< connectivity upkeep and checks, and making the split parts' bodies
+  double partBodiesMs = 0;       ///< of splitMs: making the parts' grids and bodies
 };
 
 class World {
@@ -187,6 +189,16 @@ class World {
   /// dropped. Not while step() runs. InvalidInput (nothing moved) when a list's size is not
   /// the body count or a value is not finite.
   void setPoses(const std::vector<Vec3d>& positions, const std::vector<Quatf>& rotations);
+  /// The next frame's edits only (the scene's edit load, then splits, wakes and pair caches),
+  /// without simulating it: for a world that follows another engine's run through setPoses()
+  /// and must see the same edits (the Bullet baseline's judge). Advances frame(); lastStats()
+  /// holds the edit figures (edit, edit load and split times, bricks, splits). Not while
+  /// step() runs.
+  void applyFrameEdits();
+  /// Whether steps record their edits brick by brick into lastEdits() (off: nothing kept).
+  void recordEdits(bool on);
+  /// The last step's, applyFrameEdits()' or removeBricks()' edits, when recordEdits(true) (edit_log.h).
+  const EditLog& lastEdits() const { return editLog_; }
 
  private:
   // Scene building (scene_build.cpp).
@@ -231,8 +243,11 @@ class World {
   EditLoad::Blocked editBlockers();
   /// Split grids edited through editGrid() get their connectivity taken again.
   void refreshStaleLinks();
-  /// The edit load's hooks keeping split grids' connectivity (none without such grids).
-  EditLoad::Hooks connectivityHooks();
+  /// The edit load's hooks: split grids' connectivity kept, the edit log written (none when
+  /// neither is needed).
+  EditLoad::Hooks editHooks();
+  /// A frame's edits: the edit load, splits, then wakes, masses and pair caches (step's first part).
+  void runEdits();
   /// Parts the frame's removals detached from split grids become dynamic bodies (or vanish).
   void splitDetachedParts();
   void makeBodyOfPart(uint32_t grid, const std::vector<uint32_t>& part);
@@ -306,6 +321,8 @@ class World {
   std::vector<uint32_t> editedGrids_;  // grids edited since the last step (editGrid(), the edit load)
   std::vector<uint32_t> wholeGridEdits_;  // of those, the ones handed out by editGrid()
   BodyBoxIndex editedBoxes_;           // the edit load's bricks of this frame, in the world
+  EditLog editLog_;                    // the frame's edits brick by brick (when recordingEdits_)
+  bool recordingEdits_ = false;
   EditLoad editLoad_;                  // the scene's edits, applied at the start of each step
   // Grids that split (GridDescription::split): per grid, its connectivity (null: does not split),
   // the removed bricks' neighbours of this frame, and its debris threshold.

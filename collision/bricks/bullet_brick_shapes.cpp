@@ -95,21 +95,26 @@ size_t BulletBrickShapes::bytes() const {
   return total;
 }
 
-std::vector<BulletBrickChunk> buildBulletChunks(const BrickGrid& grid, float chunkSize, BulletBrickShapes& shapes) {
+BulletChunkCell bulletChunkCell(const Vec3f& p, float chunkSize) {
+  return {int64_t(std::floor(p.x() / chunkSize)), int64_t(std::floor(p.y() / chunkSize)), int64_t(std::floor(p.z() / chunkSize))};
+}
+
+Vec3f bulletChunkOrigin(const BulletChunkCell& cell, float chunkSize) {
+  return Vec3f((float(cell[0]) + 0.5f) * chunkSize, (float(cell[1]) + 0.5f) * chunkSize, (float(cell[2]) + 0.5f) * chunkSize);
+}
+
+std::vector<BulletBrickChunk> buildBulletChunks(const BrickGrid& grid, float chunkSize, BulletBrickShapes& shapes,
+                                                std::vector<std::vector<uint32_t>>* childBricks) {
   requireInRange(chunkSize, 1e-6, 1e9, "buildBulletChunks", "chunkSize");
-  using Cell = std::array<int64_t, 3>;
-  std::map<Cell, std::vector<uint32_t>> cells;  // ordered: chunks come out in cube order
-  grid.forEachBrick([&](uint32_t id) {
-    const Vec3f& p = grid.brick(id).position;
-    cells[{int64_t(std::floor(p.x() / chunkSize)), int64_t(std::floor(p.y() / chunkSize)), int64_t(std::floor(p.z() / chunkSize))}]
-        .push_back(id);
-  });
+  std::map<BulletChunkCell, std::vector<uint32_t>> cells;  // ordered: chunks come out in cube order
+  grid.forEachBrick([&](uint32_t id) { cells[bulletChunkCell(grid.brick(id).position, chunkSize)].push_back(id); });
   std::vector<BulletBrickChunk> chunks;
   chunks.reserve(cells.size());
+  if (childBricks) childBricks->clear();
   for (auto& [cell, ids] : cells) {
     std::sort(ids.begin(), ids.end());  // the same children order whatever the pool's order
     BulletBrickChunk c;
-    c.origin = Vec3f((float(cell[0]) + 0.5f) * chunkSize, (float(cell[1]) + 0.5f) * chunkSize, (float(cell[2]) + 0.5f) * chunkSize);
+    c.origin = bulletChunkOrigin(cell, chunkSize);
     c.shape = std::make_unique<btCompoundShape>(true, int(ids.size()));
     for (uint32_t id : ids) {
       const Brick& b = grid.brick(id);
@@ -120,6 +125,7 @@ std::vector<BulletBrickChunk> buildBulletChunks(const BrickGrid& grid, float chu
     c.shape->getDynamicAabbTree()->optimizeTopDown();
     c.bricks = uint32_t(ids.size());
     chunks.push_back(std::move(c));
+    if (childBricks) childBricks->push_back(std::move(ids));
   }
   return chunks;
 }

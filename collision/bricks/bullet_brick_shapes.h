@@ -11,6 +11,7 @@
 ///   std::vector<BulletBrickChunk> chunks = buildBulletChunks(grid, 8.f, shapes);
 ///   // each chunk: a btCollisionObject at gridPose * btTransform(identity, chunk.origin)
 #include <btBulletCollisionCommon.h>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -59,7 +60,14 @@ struct BulletBrickChunk {
 /// per non-empty cube (its dynamic AABB tree on, rebuilt top-down). Chunks come out in a fixed order (by cube
 /// coordinates), so two builds of the same grid are equal. Throws InvalidInput when chunkSize
 /// is not positive and finite.
-std::vector<BulletBrickChunk> buildBulletChunks(const BrickGrid& grid, float chunkSize, BulletBrickShapes& shapes);
+/// `childBricks`, when given, receives each chunk's brick ids in child order.
+std::vector<BulletBrickChunk> buildBulletChunks(const BrickGrid& grid, float chunkSize, BulletBrickShapes& shapes,
+                                                std::vector<std::vector<uint32_t>>* childBricks = nullptr);
+
+/// The cube of edge `chunkSize` holding grid-local point `p`, and that cube's centre (a chunk's origin).
+using BulletChunkCell = std::array<int64_t, 3>;
+BulletChunkCell bulletChunkCell(const Vec3f& p, float chunkSize);
+Vec3f bulletChunkOrigin(const BulletChunkCell& cell, float chunkSize);
 
 /// Bytes Bullet holds for one compound child: the child record and two tree nodes.
 constexpr size_t kBulletCompoundChildBytes = sizeof(btCompoundShapeChild) + 2 * sizeof(btDbvtNode);

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
+
+#include "collision/core/errors.h"
+#include "collision/core/seeded_random.h"
 
 namespace bw {
 
@@ -70,6 +74,25 @@ void generateRollingHills(VoxelTerrain& t, uint32_t seed, int base, int amplitud
       t.fillBox({x, 0, z}, {x, h, z}, Voxel::make(uint8_t(kMaterialFirstSolid + (h % 4)), 255));
       if (h < waterLevel) t.fillBox({x, h + 1, z}, {x, std::min(waterLevel, s.y - 1), z}, Voxel::make(kMaterialWater, 255));
     }
+  }
+}
+
+void generateQuarry(VoxelTerrain& t, uint32_t seed) {
+  const Int3 s = t.size();
+  if (s.x < 32 || s.y < 32 || s.z < 16)
+    throw InvalidInput("generateQuarry: the terrain is " + std::to_string(s.x) + " x " + std::to_string(s.y) + " x " + std::to_string(s.z) +
+                       " voxels, at least 32 x 32 x 16 needed");
+  SeededRandom r(seed);
+  const int ground = 4, top = s.z * 3 / 4, edge = 4;
+  t.fillBox({0, 0, 0}, {s.x - 1, s.y - 1, ground - 1}, Voxel::make(kMaterialFirstSolid));
+  const int cliffFront = s.y - s.y / 5;
+  t.fillBox({edge, cliffFront, ground}, {s.x - 1 - edge, s.y - 1, top - 1}, Voxel::make(kMaterialFirstSolid + 1));
+  const int finY = cliffFront - 6;
+  t.fillBox({edge + 2, finY, ground}, {s.x - 3 - edge, finY + 1, top * 4 / 5 - 1}, Voxel::make(kMaterialFirstSolid + 2));
+  const int pillarY = finY - 10;
+  for (int x = edge + 2; x + 4 <= s.x - edge; x += 10) {
+    const int h = ground + int(float(top - ground) * float(r.uniform(0.6, 1.0)));
+    t.fillBox({x, pillarY, ground}, {x + 3, pillarY + 3, h - 1}, Voxel::make(kMaterialFirstSolid + 3));
   }
 }
 

@@ -18,6 +18,13 @@ void generateRandomTerrain(VoxelTerrain& t, uint32_t seed, float blobDensity = 0
 /// every column up to `waterLevel`. One fillBox per column: fast enough for 1024^2 columns.
 void generateRollingHills(VoxelTerrain& t, uint32_t seed, int base, int amplitude, int waterLevel);
 
+/// A quarry, z up: solid ground 4 voxels thick over the whole terrain, then (back to front in
+/// y) a cliff a fifth of the depth thick rising to 3/4 of the height, a fin 2 voxels thick in
+/// front of it, and a row of 4 x 4 pillars of seeded heights in front of that: what carving
+/// cuts into slabs and pillar tops that break free. Needs at least 32 x 32 x 16 voxels
+/// (InvalidInput otherwise). Materials 2 (ground), 3 (cliff), 4 (fin), 5 (pillars).
+void generateQuarry(VoxelTerrain& t, uint32_t seed);
+
 /// A smooth heightfield triangle mesh with 32-bit indices: (n + 1)^2 vertices, 2 n^2 triangles.
 struct HeightfieldMesh {
   std::vector<Vec3f> vertices;   ///< grid vertices, spacing apart in X and Z

@@ -181,6 +181,10 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
       ->check(CLI::IsMember({"brickworld", "bullet", "bullet-naive", "both", "all"}));
   cmd.add_option("--bullet-chunk", scene->bulletChunk, "scene: chunk edge of the expert Bullet setup's static compounds, m (default 16, the fastest measured)")
       ->check(CLI::Range(0.1f, 10000.f));
+  cmd.add_option("--bullet-kinematic", scene->bulletKinematic,
+                 "scene: how the expert Bullet setup holds a kinematic grid: compound (one body of chunk compounds), chunks (one "
+                 "kinematic body per chunk) or auto (chunks from 256 dynamic bodies on; default)")
+      ->check(CLI::IsMember({"auto", "compound", "chunks"}));
   cmd.add_option("--submission", scene->submission,
                  "scene with attachments: how transform updates reach the render thread: batched (default: one atomic-append "
                  "batch committed once per frame), mutex or concurrent (one command per update into a mutex / lock-free queue), "

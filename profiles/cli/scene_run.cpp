@@ -61,13 +61,13 @@ nlohmann::json insideSolidList(const ContainmentReport& inside, const std::vecto
 // and its containment tracker counts Bullet's bodies inside solid as it counts ours (except
 // bodies our World spawned inside solid: they stay kinematic in the judge, which never steps,
 // and the tracker follows dynamic bodies only). Returns the median frame time.
-double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, float chunkSize, uint32_t frames, bool json,
-                 nlohmann::json& out) {
+double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, float chunkSize, KinematicGrids kinematic,
+                 uint32_t frames, bool json, nlohmann::json& out) {
   using Clock = std::chrono::steady_clock;
   SceneDescription judged = scene;
   judged.attachments = AttachmentsDescription{};  // the judge only answers containment queries
   World judge(judged, threads);
-  BulletBaseline bullet(judge, setup, chunkSize);
+  BulletBaseline bullet(judge, setup, chunkSize, kinematic);
   ContainmentTracker containment(judge);
   std::vector<Vec3d> positions;
   std::vector<Quatf> rotations;
@@ -75,10 +75,27 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
   uint64_t contacts = 0, rays = 0, rayHits = 0;
   float deepest = 0, endDeepest = 0;
   const char* label = setup == BulletSetup::Expert ? "bullet" : "bullet-naive";
+  // Edits: the judge makes the scene's edit load on its grids at Bullet's poses, and Bullet
+  // makes the same bricks' edits on its compounds. What to edit (the load's choosing) and the
+  // connectivity search are game-side work done by the same code for both engines: their time
+  // is counted in Bullet's frame as it is in ours; our grids' own edits and parts are not.
+  const bool edits = !scene.edits.empty();
+  judge.recordEdits(edits);
+  Series editTimes;
+  uint64_t bricksEdited = 0;
   for (uint32_t f = 0; f < frames; ++f) {
+    double gameSideMs = 0;
+    if (edits) {
+      judge.applyFrameEdits();
+      const StepStats& e = judge.lastStats();
+      gameSideMs = e.editLoadMs + e.splitMs - e.partBodiesMs;
+      bricksEdited += e.bricksRemoved + e.bricksPlaced;
+    }
     const auto t = Clock::now();
+    if (edits) bullet.applyEdits(judge);
     bullet.step();
-    total.v.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+    total.v.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count() + gameSideMs);
+    if (edits) editTimes.v.push_back(bullet.lastEditSeconds() * 1e3);
     const BulletFrame figures = bullet.lastFrame();
     contacts += figures.contacts;
     rays += figures.rays;
@@ -98,7 +115,9 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
   char chunk[32];
   std::snprintf(chunk, sizeof chunk, "%g", double(chunkSize));
   const std::string how = setup == BulletSetup::Expert
-                              ? std::string("static grids as ") + chunk + " m chunk compounds, CCD, split impulse"
+                              ? std::string("static grids as ") + chunk + " m chunk compounds, kinematic grids as " +
+                                    (bullet.kinematicGrids() == KinematicGrids::ChunkBodies ? "a body per chunk" : "one compound") +
+                                    ", CCD, split impulse"
                               : "each grid one btCompoundShape of one box per brick, no CCD";
   out = {{"engine", label},
          {"setup", how},
@@ -113,7 +132,15 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
          {"bodies_inside_solid", inside.count()},
          {"max_penetration_m", deepest},
          {"end_penetration_m", endDeepest}};
-  if (setup == BulletSetup::Expert) out["chunk_m"] = chunkSize;
+  if (setup == BulletSetup::Expert) {
+    out["chunk_m"] = chunkSize;
+    out["kinematic_grids"] = kinematicGridsName(bullet.kinematicGrids());
+  }
+  if (edits) {
+    out["edit"] = {{"median_ms", editTimes.quantile(0.5)}, {"max_ms", editTimes.max()},
+                   {"us_per_brick", editTimes.sum() * 1e3 / double(std::max<uint64_t>(bricksEdited, 1))},
+                   {"bricks_edited", bricksEdited}, {"parts_made", bullet.partsMade()}};
+  }
   if (inside.count()) out["inside_solid"] = insideSolidList(inside, positions);
   if (rays) {
     out["rays_per_frame"] = double(rays) / frames;
@@ -122,6 +149,11 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
   if (!json) {
     std::printf("%s (btDiscreteDynamicsWorld, %s): built in %.0f ms\n", label, how.c_str(), bullet.buildSeconds() * 1e3);
     std::printf("  frame       %7.3f ms %7.3f ms %7.3f ms   (median, p95, max)\n", total.quantile(0.5), total.quantile(0.95), total.max());
+    if (edits)
+      std::printf("  edits       %7.3f ms %7.3f ms           (median, max per frame: chunk children, AABBs, masses, wakes, parts), "
+                  "%.2f us per brick, %u parts made\n",
+                  editTimes.quantile(0.5), editTimes.max(), editTimes.sum() * 1e3 / double(std::max<uint64_t>(bricksEdited, 1)),
+                  bullet.partsMade());
     std::printf("  per frame: %.0f contacts", double(contacts) / frames);
     if (rays) std::printf(", %.0f rays (%.1f%% hit)", double(rays) / frames, 100.0 * double(rayHits) / double(rays));
     std::printf("\n  dynamic bodies at the end: %u resting, %u moving, lowest at z = %.2f\n", resting, moving,
@@ -155,10 +187,10 @@ int runScene(const SceneRunOptions& o) {
   const std::vector<BulletSetup> setups = bulletSetups(o.engine);
   if (o.engine != "brickworld" && setups.empty())
     throw std::invalid_argument("--engine must be brickworld, bullet, bullet-naive, both or all (got '" + o.engine + "')");
-  if (!setups.empty()) BulletBaseline::requireMirrorable(scene);  // refuse before running ours
+  for (BulletSetup setup : setups) BulletBaseline::requireMirrorable(scene, setup);  // refuse before running ours
   if (o.engine == "bullet" || o.engine == "bullet-naive") {
     nlohmann::json b;
-    runBullet(scene, o.threads, setups[0], o.bulletChunk, o.frames ? o.frames : scene.settings.frames, o.json, b);
+    runBullet(scene, o.threads, setups[0], o.bulletChunk, kinematicGridsFromName(o.bulletKinematic), o.frames ? o.frames : scene.settings.frames, o.json, b);
     if (o.json) std::cout << nlohmann::json{{"scene", scene.name}, {"engine", o.engine}, {"bullet", b}}.dump(2) << "\n";
     return 0;
   }
@@ -335,7 +367,7 @@ int runScene(const SceneRunOptions& o) {
     }
     for (BulletSetup setup : setups) {
       nlohmann::json b;
-      const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, frames, true, b);
+      const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, kinematicGridsFromName(o.bulletKinematic), frames, true, b);
       const std::string key = setup == BulletSetup::Expert ? "bullet" : "bullet_naive";
       j[key] = b;
       j[key + "_over_brickworld_median"] = bulletMedian / std::max(total.quantile(0.5), 1e-9);
@@ -394,7 +426,7 @@ int runScene(const SceneRunOptions& o) {
   }
   for (BulletSetup setup : setups) {
     nlohmann::json b;
-    const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, frames, false, b);
+    const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, kinematicGridsFromName(o.bulletKinematic), frames, false, b);
     std::printf("%s / brickworld median frame time: %.1fx\n", setup == BulletSetup::Expert ? "bullet" : "bullet-naive",
                 bulletMedian / std::max(total.quantile(0.5), 1e-9));
   }

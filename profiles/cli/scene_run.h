@@ -21,6 +21,7 @@ struct SceneRunOptions {
   /// both (brickworld and bullet) or all (the three): same initial state, ratios printed.
   std::string engine = "brickworld";
   float bulletChunk = BulletBaseline::kDefaultChunkSize;  ///< edge of the expert Bullet setup's chunk compounds (m)
+  std::string bulletKinematic = "auto";                   ///< how the expert setup holds kinematic grids (KinematicGrids)
   std::string sleeping;     ///< "on"/"off" overrides the scene's setting; empty keeps it
   /// Scenes with attachments: batched, mutex or concurrent (per-object queues, one command per
   /// record, like for like with the batch), or all (the three from the same initial state).
