@@ -6,6 +6,7 @@
 #include "collision/content/brs_reader.h"
 #include "collision/content/build_generators.h"
 #include "collision/content/build_tiling.h"
+#include "collision/content/terrain_generator.h"
 #include "collision/content/vox_reader.h"
 #include "collision/core/argument_checks.h"
 #include "collision/core/seeded_random.h"
@@ -68,6 +69,13 @@ void World::buildGrid(const GridDescription& g) {
 }
 
 void World::buildTerrain(const TerrainDescription& t) {
+  if (!t.generator.empty()) {
+    // A generated terrain (terrain_generator.h): its voxel (0, 0, 0) corner at the position.
+    auto terrain = std::make_unique<Terrain>(t.size, t.voxelSize, RigidTransform{t.position, Quatf::Identity()});
+    terrain->edit({0, 0, 0}, {t.size.x - 1, t.size.y - 1, t.size.z - 1}, [&](VoxelTerrain& v) { generateQuarry(v, uint32_t(t.seed)); });
+    addTerrainBody(std::move(terrain), t, t.anchorBelow);
+    return;
+  }
   VoxMaterialMap materials;
   if (t.waterFirst >= 0) {
     materials.waterFirst = t.waterFirst;
@@ -85,10 +93,15 @@ void World::buildTerrain(const TerrainDescription& t) {
   // around the model, so its own origin sits that margin lower.
   const Vec3d margin(built.voxToTerrain.x, built.voxToTerrain.y, built.voxToTerrain.z);
   built.terrain->setPlacement(RigidTransform{t.position - margin * double(t.voxelSize), Quatf::Identity()});
+  addTerrainBody(std::move(built.terrain), t, t.anchorBelow + built.voxToTerrain.z);
+}
+
+void World::addTerrainBody(std::unique_ptr<Terrain> terrain, const TerrainDescription& t, int32_t anchorZ) {
   BodyShape shape;
   shape.terrain = uint32_t(terrains_.size());
-  terrains_.push_back(std::move(built.terrain));
+  terrains_.push_back(std::move(terrain));
   waterDensity_.push_back(t.waterDensity);
+  terrainBreaks_.push_back({t.breakFree, anchorZ, t.debrisVoxels});
   const RigidTransform& placement = terrains_.back()->placement();
   bodies_.add(placement.translation, placement.rotation, MotionType::Static, shape, 0.f, Vec3f::Zero());
 }

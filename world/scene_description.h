@@ -9,6 +9,7 @@
 
 #include "collision/bricks/brick.h"
 #include "collision/core/math_types.h"
+#include "collision/terrain/voxel_chunk.h"
 
 namespace bw {
 
@@ -35,6 +36,7 @@ constexpr double kMinRenderChunk = 0.1, kMaxRenderChunk = 1e4;  ///< grid render
 constexpr uint32_t kMaxBatchCapacity = 1u << 28;                 ///< records per frame in a batch
 constexpr uint32_t kMaxEditsPerFrame = 1'000'000;                ///< bricks or holes per edit stream per frame
 constexpr uint32_t kMaxWallLength = 100'000;                     ///< bricks per course of an edit wall
+constexpr int32_t kMaxGeneratedTerrain = 2048;                   ///< voxels along each axis of a generated terrain
 }  // namespace scene_limits
 
 /// How a body moves.
@@ -85,7 +87,15 @@ struct SpawnerDescription {
 /// A voxel terrain from a MagicaVoxel model (static; solid voxels collide, water voxels float).
 struct TerrainDescription {
   std::string name;
-  std::string file;                ///< .vox path (resolved against the scene file)
+  std::string file;                ///< .vox path (resolved against the scene file), or empty
+  std::string generator;           ///< "quarry" (terrain_generator.h) when there is no file
+  Int3 size{96, 64, 48};           ///< generator: voxels along x, y, z
+  uint64_t seed = 1;               ///< generator: its seed
+  /// Solid regions that edits cut off from the anchored voxels (model z below anchorBelow:
+  /// 1 anchors the bottom layer) become dynamic bodies (World, voxel_regions.h).
+  bool breakFree = false;
+  int32_t anchorBelow = 1;
+  uint32_t debrisVoxels = 0;       ///< with breakFree: regions of fewer voxels vanish instead
   float voxelSize = 1.f;           ///< edge of one voxel in world units
   Vec3d position = Vec3d::Zero();  ///< world position of the model's voxel (0, 0, 0) corner
   int waterFirst = -1, waterLast = -1;  ///< palette index range that is water (-1: none)
@@ -120,7 +130,13 @@ struct EditLoadDescription {
     Carve,   ///< perFrame holes: every brick whose centre lies within radius of a random brick's
     Wall,    ///< perFrame bricks of a wall rising course by course on top of the grid
   };
-  std::string grid;                 ///< name of a grid in grids
+  std::string grid;                 ///< name of a grid in grids (or empty: terrain)
+  /// Or the name of a terrain in terrains: only Carve, of spheres of `radius` metres centred on
+  /// random solid voxels above the anchor inside [regionMin, regionMax] (world; the whole
+  /// terrain when hasRegion is false).
+  std::string terrain;
+  bool hasRegion = false;
+  Vec3d regionMin = Vec3d::Zero(), regionMax = Vec3d::Zero();
   Kind kind = Kind::Remove;
   uint32_t perFrame = 1;            ///< bricks (Remove, Place, Wall) or holes (Carve) per edit frame
   uint32_t firstFrame = 0;          ///< the first frame that edits

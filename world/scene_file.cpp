@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "collision/content/build_generators.h"
+#include "collision/terrain/voxel_terrain.h"
 #include "collision/core/argument_checks.h"
 
 namespace bw {
@@ -266,10 +267,28 @@ SceneSettings parseSettings(const Field& f) {
 }
 
 TerrainDescription parseTerrain(const Field& f, const std::string& sceneSource) {
-  f.allowOnly({"name", "file", "voxel_size", "position", "water", "water_density"});
+  f.allowOnly({"name", "file", "generator", "size", "seed", "voxel_size", "position", "water", "water_density", "break_free",
+               "anchor_below", "debris_voxels"});
   TerrainDescription t;
   t.name = f.at("name").string();
-  t.file = contentPath(f.at("file"), sceneSource, ".vox");
+  if (f.has("file") == f.has("generator")) f.failMessage("needs exactly one of \"file\" (a .vox) and \"generator\" (\"quarry\")");
+  if (f.has("file")) {
+    t.file = contentPath(f.at("file"), sceneSource, ".vox");
+  } else {
+    t.generator = f.at("generator").oneOf({"quarry"});
+    if (f.has("size")) {
+      const Field size = f.at("size");
+      if (size.arraySize(3) != 3) size.fail("[x, y, z] voxels");
+      const int64_t lo[3] = {32, 32, 16};
+      t.size = {int32_t(size.index(0).integer(lo[0], scene_limits::kMaxGeneratedTerrain)),
+                int32_t(size.index(1).integer(lo[1], scene_limits::kMaxGeneratedTerrain)),
+                int32_t(size.index(2).integer(lo[2], scene_limits::kMaxGeneratedTerrain))};
+    }
+    if (f.has("seed")) t.seed = f.at("seed").seed();
+  }
+  if (f.has("break_free")) t.breakFree = f.at("break_free").boolean();
+  if (f.has("anchor_below")) t.anchorBelow = int32_t(f.at("anchor_below").integer(0, VoxelTerrain::kMaxSize));
+  if (f.has("debris_voxels")) t.debrisVoxels = uint32_t(f.at("debris_voxels").integer(0, UINT32_MAX));
   if (f.has("voxel_size")) t.voxelSize = float(f.at("voxel_size").number(scene_limits::kMinVoxelSize, scene_limits::kMaxVoxelSize));
   if (f.has("position")) t.position = f.at("position").vec3(-kMaxCoord, kMaxCoord);
   if (f.has("water")) {
@@ -307,14 +326,34 @@ AttachmentsDescription parseAttachments(const Field& f) {
   return a;
 }
 
-EditLoadDescription parseEdit(const Field& f, const std::vector<GridDescription>& grids) {
-  f.allowOnly({"grid", "kind", "per_frame", "first_frame", "last_frame", "every", "radius", "brick_half_size", "wall_length", "seed"});
+EditLoadDescription parseEdit(const Field& f, const std::vector<GridDescription>& grids, const std::vector<TerrainDescription>& terrains) {
+  f.allowOnly({"grid", "terrain", "kind", "per_frame", "first_frame", "last_frame", "every", "radius", "brick_half_size", "wall_length",
+               "seed", "region"});
   using namespace scene_limits;
   EditLoadDescription e;
-  const Field g = f.at("grid");
-  e.grid = g.string();
-  if (std::none_of(grids.begin(), grids.end(), [&](const GridDescription& d) { return d.name == e.grid; }))
-    g.fail("the name of a grid declared in \"grids\"");
+  if (f.has("grid") == f.has("terrain")) f.failMessage("needs exactly one of \"grid\" and \"terrain\"");
+  if (f.has("grid")) {
+    const Field g = f.at("grid");
+    e.grid = g.string();
+    if (std::none_of(grids.begin(), grids.end(), [&](const GridDescription& d) { return d.name == e.grid; }))
+      g.fail("the name of a grid declared in \"grids\"");
+  } else {
+    const Field t = f.at("terrain");
+    e.terrain = t.string();
+    if (std::none_of(terrains.begin(), terrains.end(), [&](const TerrainDescription& d) { return d.name == e.terrain; }))
+      t.fail("the name of a terrain declared in \"terrains\"");
+    f.at("kind").oneOf({"carve"});  // terrains are carved only
+  }
+  if (f.has("region")) {
+    if (!f.has("terrain")) f.at("region").failMessage("only terrain edits take a region");
+    const Field region = f.at("region");
+    region.allowOnly({"min", "max"});
+    e.hasRegion = true;
+    e.regionMin = region.at("min").vec3(-kMaxCoord, kMaxCoord);
+    e.regionMax = region.at("max").vec3(-kMaxCoord, kMaxCoord);
+    for (int i = 0; i < 3; ++i)
+      if (e.regionMin[i] > e.regionMax[i]) region.failMessage(std::string("min.") + "xyz"[i] + " is greater than max." + "xyz"[i]);
+  }
   const std::string kind = f.at("kind").oneOf({"remove", "place", "carve", "wall"});
   e.kind = kind == "remove" ? EditLoadDescription::Kind::Remove
          : kind == "place"  ? EditLoadDescription::Kind::Place
@@ -373,7 +412,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
   if (root.has("edits")) {
     const Field edits = root.at("edits");
     const size_t n = edits.arraySize(1'000);
-    for (size_t i = 0; i < n; ++i) scene.edits.push_back(parseEdit(edits.index(i), scene.grids));
+    for (size_t i = 0; i < n; ++i) scene.edits.push_back(parseEdit(edits.index(i), scene.grids, scene.terrains));
   }
   if (scene.grids.empty() && scene.spawners.empty() && scene.terrains.empty())
     root.failMessage("declares no grids, spawners or terrains: nothing to simulate");

@@ -103,6 +103,14 @@ void validateScene(const SceneDescription& scene) {
     c.vector(f + ".position", t.position, -kMaxCoordinate, kMaxCoordinate);
     c.number(f + ".water_density", t.waterDensity, kMinWaterDensity, kMaxWaterDensity);
     if (t.waterFirst >= 0 && (t.waterFirst > t.waterLast || t.waterLast > 255)) c.message(f + ".water", "expected 1 <= first <= last <= 255");
+    if (t.file.empty() == t.generator.empty()) c.message(f, "expected exactly one of file and generator");
+    if (!t.generator.empty() && t.generator != "quarry") c.message(f + ".generator", "expected \"quarry\", got '" + t.generator + "'");
+    if (!t.generator.empty() && (t.size.x < 32 || t.size.y < 32 || t.size.z < 16 || t.size.x > kMaxGeneratedTerrain ||
+                                 t.size.y > kMaxGeneratedTerrain || t.size.z > kMaxGeneratedTerrain))
+      c.message(f + ".size", "expected at least 32 x 32 x 16 and at most " + std::to_string(kMaxGeneratedTerrain) + " voxels a side");
+    if (t.anchorBelow < 0) c.message(f + ".anchor_below", "expected a height of 0 or more (model voxels)");
+    if (t.breakFree && scene.attachments.enabled)
+      c.message(f + ".break_free", "not with attachments yet: regions broken free would have no render proxies");
   }
   for (size_t i = 0; i < scene.grids.size(); ++i) {
     const GridDescription& g = scene.grids[i];
@@ -118,8 +126,18 @@ void validateScene(const SceneDescription& scene) {
   for (size_t i = 0; i < scene.edits.size(); ++i) {
     const EditLoadDescription& e = scene.edits[i];
     const std::string f = "edits[" + std::to_string(i) + "]";
-    if (std::none_of(scene.grids.begin(), scene.grids.end(), [&](const GridDescription& g) { return g.name == e.grid; }))
+    if (e.grid.empty() == e.terrain.empty()) c.message(f, "expected exactly one of grid and terrain");
+    if (!e.grid.empty() && std::none_of(scene.grids.begin(), scene.grids.end(), [&](const GridDescription& g) { return g.name == e.grid; }))
       c.message(f + ".grid", "expected the name of a grid declared in grids, got '" + e.grid + "'");
+    if (!e.terrain.empty()) {
+      if (std::none_of(scene.terrains.begin(), scene.terrains.end(), [&](const TerrainDescription& t) { return t.name == e.terrain; }))
+        c.message(f + ".terrain", "expected the name of a terrain declared in terrains, got '" + e.terrain + "'");
+      if (e.kind != EditLoadDescription::Kind::Carve) c.message(f + ".kind", "terrains are carved only (\"carve\")");
+      c.vector(f + ".region.min", e.regionMin, -kMaxCoordinate, kMaxCoordinate);
+      c.vector(f + ".region.max", e.regionMax, -kMaxCoordinate, kMaxCoordinate);
+      for (int a = 0; a < 3; ++a)
+        if (e.hasRegion && e.regionMin[a] > e.regionMax[a]) c.message(f + ".region", "min is above max along " + std::string(1, "xyz"[a]));
+    }
     c.number(f + ".per_frame", e.perFrame, 1, kMaxEditsPerFrame);
     c.number(f + ".every", e.every, 1, UINT32_MAX);
     if (e.lastFrame < e.firstFrame) c.message(f + ".last_frame", "is before first_frame");

@@ -15,6 +15,7 @@ namespace bw {
 struct TerrainPairWork {
   struct Query {
     uint32_t pair, body, terrain;
+    uint32_t brick = kWholeBody;  // a small grid's brick (queried brick by brick), or the whole body
     RigidTransform pose;  // the body's shape (or its grid's hull) in the world
     QueryShape shape;
     float margin = 0.f;
@@ -22,6 +23,11 @@ struct TerrainPairWork {
     bool wet = false;
     WaterContact water;
     uint32_t firstPiece = 0, pieceCount = 0;
+  };
+  static constexpr uint32_t kWholeBody = ~0u;
+  /// A pair's queries: one, or one per brick of a small grid (kBrickwiseGridBricks).
+  struct Group {
+    uint32_t pair, firstQuery, queryCount;
   };
   struct Piece {
     uint32_t query, begin, end;  // candidate triangles [begin, end) of that query's plan
@@ -32,9 +38,11 @@ struct TerrainPairWork {
   };
 
   std::vector<Query> queries;
+  std::vector<Group> groups;               // in pair order; their queries consecutive
   std::vector<TerrainContactPlan> plans;   // one per query (grows, never shrinks)
   std::vector<Piece> pieces;
   std::vector<PieceOutput> pieceOutputs;   // one per piece (grows, never shrinks)
+  std::vector<Vec3f> faceNormals;          // the apply stage's scratch
   std::vector<uint8_t> bodyQueried;        // per body: has a query this substep (all 0 between)
   bool bodiesUnique = true;                // no body has two queries (then buoyancy runs per query in parallel)
 };

@@ -1,15 +1,16 @@
 // Pairs with a terrain: solid contacts against the chunk triangles, then buoyancy and water
 // drag from the water voxels the body displaces. In six stages:
-//   select (one thread, pair order): the terrain pairs; a grid's hull is made here (lazily);
+//   select (one thread, pair order): the terrain pairs, each one query (a grid's hull is made
+//          here, lazily) or, for a small grid (kBrickwiseGridBricks), one query per brick;
 //   plan   (parallel, per query): the shape, its pose and margin, the candidate triangles from
 //          chunks already in the terrain's cache (TerrainContactPlan only reads), the water;
 //   cut    (one thread): each query's candidates cut into pieces;
 //   pieces (parallel, per piece): the contacts of a few candidate triangles each, so a body
 //          lying across many triangles is spread over several jobs;
-//   finish (parallel, per query): the pieces' contacts joined in order, interior edges and
-//          repeated points dropped; buoyancy when no body has two terrain queries;
-//   apply  (one thread, pair order): a query that needed a chunk not yet meshed runs again the
-//          filling way (the meshes stay lazy: only chunks a body touches are ever built, and
+//   finish (parallel, per pair): each query's pieces' contacts joined in order, interior
+//          edges and repeated points dropped; buoyancy when no body has two terrain queries;
+//   apply  (one thread, pair order): a pair with a query that needed a chunk not yet meshed
+//          runs again in query order, that query the filling way (the meshes stay lazy: only chunks a body touches are ever built, and
 //          in steady state every chunk is cached); counters; buoyancy otherwise.
 // The contacts are the same whichever stage computes them (the pieces join in the serial
 // query's order), so the state is the same for any thread count and any cache budget.
@@ -42,6 +43,7 @@ void World::terrainPairs(float dt) {
   const Vec3f g = scene_.settings.gravity.cast<float>();
   stats_.floating = 0;  // bodies in water in the last substep
   w.queries.clear();
+  w.groups.clear();
   w.bodiesUnique = true;
   {
     ProfileZone z(profiler_, "terrain: select", stage_ + kTerrainStage);
@@ -55,12 +57,28 @@ void World::terrainPairs(float dt) {
       q.pair = k;
       q.body = terrainA ? b : a;
       q.terrain = bodies_.shape[terrainA ? a : b].terrain;
-      // A grid meets terrain through its convex approximation (as it meets other grids), made
-      // here, on one thread, the first time it is needed.
-      if (bodies_.shape[q.body].isGrid()) grids_[bodies_.shape[q.body].grid]->convexApproximation(scene_.settings.approximationDepth);
       pairFlipped_[k] = q.body == b;  // normals point from the terrain towards the body
       w.bodiesUnique &= w.bodyQueried[q.body] == 0;
       w.bodyQueried[q.body] = 1;
+      w.groups.push_back({k, uint32_t(w.queries.size()), 1});
+      if (bodies_.shape[q.body].isGrid()) {
+        BrickGrid& grid = *grids_[bodies_.shape[q.body].grid];
+        if (grid.brickCount() <= kBrickwiseGridBricks) {
+          // A small grid meets terrain brick by brick, each brick the box of its shape (as
+          // against other grids: collideGrids), so a concave piece is not filled in by its hull.
+          w.groups.back().queryCount = 0;
+          w.bodiesUnique = false;
+          grid.forEachBrick([&](uint32_t id) {
+            q.brick = id;
+            w.queries.push_back(q);
+            ++w.groups.back().queryCount;
+          });
+          continue;
+        }
+        // A larger one through its convex approximation (as it meets other grids), made here,
+        // on one thread, the first time it is needed.
+        grid.convexApproximation(scene_.settings.approximationDepth);
+      }
       w.queries.push_back(q);
     }
     for (const TerrainPairWork::Query& q : w.queries) w.bodyQueried[q.body] = 0;
@@ -74,7 +92,11 @@ void World::terrainPairs(float dt) {
       const BodyPair& p = pairs_[q.pair];
       q.pose = bodies_.shapePose(q.body);
       q.shape = bodies_.shape[q.body].primitive;
-      if (bodies_.shape[q.body].isGrid()) {
+      if (q.brick != TerrainPairWork::kWholeBody) {
+        const Brick& br = grids_[bodies_.shape[q.body].grid]->brick(q.brick);
+        q.pose = RigidTransform{q.pose.pointToWorld(br.position), q.pose.rotation * br.rotation.quaternion()};
+        q.shape = QueryShape::box(br.halfSize);
+      } else if (bodies_.shape[q.body].isGrid()) {
         const ConvexApproximation& hull = grids_[bodies_.shape[q.body].grid]->convexApproximation(scene_.settings.approximationDepth);
         q.pose.translation = q.pose.pointToWorld(hull.shapeCenter());
         q.shape = hull.shape();
@@ -126,32 +148,67 @@ void World::terrainPairs(float dt) {
     bodies_.linearVelocity[body] *= std::max(0.f, 1.f - kWaterLinearDrag * f * dt);
     bodies_.angularVelocity[body] *= std::max(0.f, 1.f - kWaterAngularDrag * f * dt);
   };
-  jobs_.parallelFor(0, m, grainFor(m, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
+  // A query's contacts: its pieces joined in order, interior edges and repeats dropped, appended
+  // to its pair's list (a small grid's bricks one after another); a query planned from chunks
+  // not in the cache runs whole the filling way (apply stage). Either way the same contacts.
+  const auto join = [&](uint32_t i, std::vector<Contact>& out, std::vector<Vec3f>& faceNormals) {
+    const TerrainPairWork::Query& q = w.queries[i];
+    const size_t start = out.size();
+    faceNormals.clear();
+    for (uint32_t p = q.firstPiece; p < q.firstPiece + q.pieceCount; ++p) {
+      const TerrainPairWork::PieceOutput& o = w.pieceOutputs[p];
+      out.insert(out.end(), o.contacts.begin(), o.contacts.end());
+      faceNormals.insert(faceNormals.end(), o.faceNormals.begin(), o.faceNormals.end());
+    }
+    finishTerrainContacts(out, start, faceNormals);
+    if (q.brick != TerrainPairWork::kWholeBody)
+      for (size_t c = start; c < out.size(); ++c) out[c].featureB = smallFeature(out[c].featureB, q.brick);
+  };
+  const uint32_t groupCount = uint32_t(w.groups.size());
+  jobs_.parallelFor(0, groupCount, grainFor(groupCount, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "terrain: finish", stage_ + kTerrainStage + 4);
     // note: thread_local scratch: the face normals of one query, joined from its pieces.
     thread_local std::vector<Vec3f> faceNormals;
-    for (uint32_t i = begin; i < end; ++i) {
-      const TerrainPairWork::Query& q = w.queries[i];
-      std::vector<Contact>& out = pairContacts_[q.pair];
+    for (uint32_t g = begin; g < end; ++g) {
+      const TerrainPairWork::Group& group = w.groups[g];
+      std::vector<Contact>& out = pairContacts_[group.pair];
       out.clear();
-      faceNormals.clear();
-      for (uint32_t p = q.firstPiece; p < q.firstPiece + q.pieceCount; ++p) {
-        const TerrainPairWork::PieceOutput& o = w.pieceOutputs[p];
-        out.insert(out.end(), o.contacts.begin(), o.contacts.end());
-        faceNormals.insert(faceNormals.end(), o.faceNormals.begin(), o.faceNormals.end());
+      for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) {
+        join(i, out, faceNormals);
+        if (w.bodiesUnique && w.queries[i].wet) buoyancy(w.queries[i]);
       }
-      finishTerrainContacts(out, 0, faceNormals);
-      if (w.bodiesUnique && q.wet) buoyancy(q);
     }
   });
   ProfileZone z(profiler_, "terrain: apply", stage_ + kTerrainStage + 5);
-  for (const TerrainPairWork::Query& q : w.queries) {
-    std::vector<Contact>& out = pairContacts_[q.pair];
-    if (!q.cached) terrainContacts(*terrains_[q.terrain], q.shape, q.pose, q.margin, out);
+  std::vector<Vec3f>& faceNormals = w.faceNormals;
+  for (const TerrainPairWork::Group& group : w.groups) {
+    std::vector<Contact>& out = pairContacts_[group.pair];
+    bool allCached = true;
+    for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) allCached &= w.queries[i].cached;
+    if (!allCached) {
+      // The group again in query order, the uncached queries filling the cache.
+      out.clear();
+      for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) {
+        const TerrainPairWork::Query& q = w.queries[i];
+        if (q.cached) {
+          join(i, out, faceNormals);
+          continue;
+        }
+        const size_t start = out.size();
+        terrainContacts(*terrains_[q.terrain], q.shape, q.pose, q.margin, out);
+        if (q.brick != TerrainPairWork::kWholeBody)
+          for (size_t c = start; c < out.size(); ++c) out[c].featureB = smallFeature(out[c].featureB, q.brick);
+      }
+    }
     stats_.terrainContacts += uint32_t(out.size());
-    if (!q.wet) continue;
-    if (!w.bodiesUnique) buoyancy(q);
-    ++stats_.floating;
+    bool wet = false;
+    for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) {
+      const TerrainPairWork::Query& q = w.queries[i];
+      if (!q.wet) continue;
+      if (!w.bodiesUnique) buoyancy(q);  // (a small grid's bricks each float by their own volume)
+      wet = true;
+    }
+    stats_.floating += wet ? 1u : 0u;
   }
 }
 

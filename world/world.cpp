@@ -26,10 +26,21 @@ World::World(const SceneDescription& scene, int threads, SubmissionMode submissi
   for (const GridDescription& g : scene_.grids) buildGrid(g);
   for (const TerrainDescription& t : scene_.terrains) buildTerrain(t);
   for (const SpawnerDescription& s : scene_.spawners) spawn(s);
-  std::vector<uint32_t> editGrids;
-  for (const EditLoadDescription& e : scene_.edits)
-    editGrids.push_back(uint32_t(std::find(gridNames_.begin(), gridNames_.end(), e.grid) - gridNames_.begin()));
-  editLoad_ = EditLoad(scene_.edits, std::move(editGrids));
+  std::vector<EditLoadDescription> gridEdits;
+  std::vector<uint32_t> editGrids, editTerrains;
+  for (const EditLoadDescription& e : scene_.edits) {
+    uint32_t terrain = 0;
+    while (terrain < scene_.terrains.size() && scene_.terrains[terrain].name != e.terrain) ++terrain;
+    editTerrains.push_back(terrain);
+    if (!e.grid.empty()) {
+      gridEdits.push_back(e);
+      editGrids.push_back(uint32_t(std::find(gridNames_.begin(), gridNames_.end(), e.grid) - gridNames_.begin()));
+    }
+  }
+  editLoad_ = EditLoad(std::move(gridEdits), std::move(editGrids));
+  std::vector<int32_t> anchors;
+  for (const TerrainBreak& b : terrainBreaks_) anchors.push_back(b.anchorZ);
+  carveLoad_ = TerrainCarveLoad(scene_.edits, editTerrains, std::move(anchors));
   gridBodies_.assign(grids_.size(), {});
   for (uint32_t i = 0; i < bodies_.size(); ++i)
     if (bodies_.shape[i].isGrid()) gridBodies_[bodies_.shape[i].grid].push_back(i);
@@ -53,6 +64,13 @@ const BrickGrid& World::grid(uint32_t index) const {
   if (index >= grids_.size())
     throw InvalidInput("World::grid: index is " + std::to_string(index) + ", the world has " + std::to_string(grids_.size()) + " grids");
   return *grids_[index];
+}
+
+const Terrain& World::terrain(uint32_t index) const {
+  if (index >= terrains_.size())
+    throw InvalidInput("World::terrain: index is " + std::to_string(index) + ", the world has " + std::to_string(terrains_.size()) +
+                       " terrains");
+  return *terrains_[index];
 }
 
 BrickGrid& World::editGrid(uint32_t index) {
@@ -360,20 +378,28 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
     v = bodies_.linearVelocity[holder] + w.cross((centre - bodies_.position[holder]).cast<float>());
   }
   const uint32_t ng = uint32_t(grids_.size());
-  links_.push_back(std::move(partLinks));
+  const uint32_t body = addPartBody(std::move(grid), std::move(partLinks), debrisBricks_[g], gridNames_[g] + "/part" + std::to_string(++piecesMade_),
+                                    pose, v, w);
+  if (recordingEdits_) editLog_.splits.push_back({g, ng, body});
+  ++stats_.splits;
+}
+
+uint32_t World::addPartBody(std::unique_ptr<BrickGrid> grid, std::unique_ptr<BrickConnectivity> links, uint32_t debris, std::string name,
+                            const RigidTransform& pose, const Vec3f& v, const Vec3f& w) {
+  const uint32_t ng = uint32_t(grids_.size());
+  links_.push_back(std::move(links));
   linksStale_.push_back(0);
   splitSeeds_.emplace_back();
-  debrisBricks_.push_back(debrisBricks_[g]);
+  debrisBricks_.push_back(debris);
   grids_.push_back(std::move(grid));
-  gridNames_.push_back(gridNames_[g] + "/part" + std::to_string(++piecesMade_));
+  gridNames_.push_back(std::move(name));
   gridLights_.emplace_back();
   const uint32_t body = addGridBody(ng, pose.translation, pose.rotation, MotionType::Dynamic, v.cast<double>(), w);
   gridBodies_.push_back({body});
   solidBodies_.push_back(body);
   nearSolid_.push_back(1);
   sleep_.grow(bodies_.size());
-  if (recordingEdits_) editLog_.splits.push_back({g, ng, body});
-  ++stats_.splits;
+  return body;
 }
 
 EditLoad::Blocked World::editBlockers() {
@@ -437,6 +463,7 @@ void World::runEdits() {
     stats_.editLoadMs = msSince(load) - e.gridEditMs - stats_.splitMs;  // the connectivity hooks are split time
   }
   splitDetachedParts();
+  carveTerrains();
   const auto apply = Clock::now();
   const bool edited = !editedGrids_.empty();
   applyGridEdits();

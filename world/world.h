@@ -45,7 +45,9 @@
 #include "world/ray_load.h"
 #include "world/scene_description.h"
 #include "world/sleeping.h"
+#include "world/terrain_carve_load.h"
 #include "world/terrain_pair_work.h"
+#include "collision/terrain/voxel_regions.h"
 #include "world/world_render.h"
 
 namespace bw {
@@ -74,6 +76,11 @@ struct StepStats {
   uint32_t debrisBricks = 0;     ///< bricks of parts below a grid's debris_bricks, gone this frame
   double splitMs = 0;            ///< connectivity upkeep and checks, and making the split parts' bodies
   double partBodiesMs = 0;       ///< of splitMs: making the parts' grids and bodies
+  uint32_t voxelsCarved = 0;     ///< solid voxels the scene's terrain carves removed this frame
+  uint32_t terrainParts = 0;     ///< terrain regions cut off from the anchor that became bodies
+  uint32_t debrisVoxels = 0;     ///< voxels of cut-off regions below debris_voxels, gone
+  uint64_t voxelsSearched = 0;   ///< voxels the cut-off search visited (its work)
+  double terrainEditMs = 0;      ///< terrain carves, the cut-off search, the regions' bodies, wakes
 };
 
 class World {
@@ -107,6 +114,9 @@ class World {
   uint32_t gridCount() const { return uint32_t(grids_.size()); }
   /// Grid `index` (< gridCount(), else InvalidInput), shared by every body that is a copy of it.
   const BrickGrid& grid(uint32_t index) const;
+  /// Terrains in scene order, and terrain `index` (< terrainCount(), else InvalidInput).
+  uint32_t terrainCount() const { return uint32_t(terrains_.size()); }
+  const Terrain& terrain(uint32_t index) const;
   /// Grid `index` (< gridCount(), else InvalidInput) to edit: place or remove bricks between
   /// steps; every body using it sees the edit at the next step, bodies resting on it wake and
   /// its cached contacts are dropped; a dynamic body using it takes the grid's new mass, centre
@@ -251,6 +261,13 @@ class World {
   /// Parts the frame's removals detached from split grids become dynamic bodies (or vanish).
   void splitDetachedParts();
   void makeBodyOfPart(uint32_t grid, const std::vector<uint32_t>& part);
+  /// A dynamic body of a grid split off something (a grid part, a terrain region), at `pose`.
+  uint32_t addPartBody(std::unique_ptr<BrickGrid> grid, std::unique_ptr<BrickConnectivity> links, uint32_t debris, std::string name,
+                       const RigidTransform& pose, const Vec3f& v, const Vec3f& w);
+  // Terrain edits (terrain_breaks.cpp): the frame's carves, then regions cut off break free.
+  void addTerrainBody(std::unique_ptr<Terrain> terrain, const TerrainDescription& t, int32_t anchorZ);
+  void carveTerrains();
+  void breakTerrainFree(std::vector<WorldAabb>& changed);
   /// A dynamic grid body's mass, centre of mass and inertia after its grid was edited.
   void refreshGridBodyMass(uint32_t body);
   // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
@@ -332,6 +349,16 @@ class World {
   std::vector<uint32_t> debrisBricks_;
   uint32_t piecesMade_ = 0;
   BodyBoxIndex editBodies_;            // dynamic bodies' boxes, built when the edit load places bricks
+  // Terrains that break (TerrainDescription::breakFree), per terrain; the scene's carves.
+  struct TerrainBreak {
+    bool breakFree;
+    int32_t anchorZ;        // terrain-local voxel z below which voxels are anchored
+    uint32_t debrisVoxels;
+  };
+  std::vector<TerrainBreak> terrainBreaks_;
+  TerrainCarveLoad carveLoad_;
+  std::vector<TerrainCarve> carves_;   // this frame's
+  DetachedVoxelSearch voxelSearch_;
   std::vector<std::vector<uint32_t>> gridBodies_;  // per grid: the bodies holding it (built once)
   // The edits' profiling stage: one serial stage before the substeps' (they run first), below
   // the coloured islands' wave stages.

@@ -182,9 +182,19 @@ class BrickGrid {
 };
 
 /// Grid vs grid (article 000): the grid with fewer bricks collides as its convex approximation
-/// (box or hull, at `depth`) against the other's bricks. Contacts are world-space with normals
-/// pointing from `larger` towards `smaller`; returns which grid was treated as the smaller (0 =
-/// a, 1 = b) through smallerIndex.
+/// (box or hull, at `depth`) against the other's bricks; a small grid (at most
+/// kBrickwiseGridBricks bricks) collides brick by brick instead, each brick as the box of its
+/// shape (a wedge or cylinder as its bounding box), so a concave piece (a carved slab, a ring's
+/// part) is not filled in by its hull; each contact's feature then mixes in the small grid's
+/// brick (smallFeature), so warm starting tells the bricks apart. Contacts are world-space
+/// with normals pointing from `larger` towards `smaller`; returns which grid was treated as the
+/// smaller (0 = a, 1 = b) through smallerIndex.
+/// Bricks up to which a grid collides brick by brick against grids and terrains (collideGrids,
+/// the world's terrain pairs): above it the hull's one query is cheaper than the bricks' many.
+constexpr uint32_t kBrickwiseGridBricks = 128;
+/// A contact feature of a small grid's brick `brick` against feature `feature` of the other side.
+inline uint32_t smallFeature(uint32_t feature, uint32_t brick) { return feature ^ (brick * 0x9E3779B1u); }
+
 size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
                     const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
                     ContactStats* stats = nullptr);

@@ -148,6 +148,17 @@ size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, con
   const RigidTransform& smallPose = aSmaller ? poseA : poseB;
   const RigidTransform& largePose = aSmaller ? poseB : poseA;
   if (small.brickCount() == 0 || large.brickCount() == 0) return 0;
+  if (small.brickCount() <= kBrickwiseGridBricks) {
+    size_t total = 0;
+    small.forEachBrick([&](uint32_t id) {
+      const Brick& br = small.brick(id);
+      const RigidTransform pose{smallPose.pointToWorld(br.position), smallPose.rotation * br.rotation.quaternion()};
+      const size_t before = out.size();
+      total += large.collide(largePose, QueryShape::box(br.halfSize), pose, params, scratch, out, stats);
+      for (size_t k = before; k < out.size(); ++k) out[k].featureB = smallFeature(out[k].featureB, id);
+    });
+    return total;
+  }
   const ConvexApproximation& approx = small.convexApproximation(depth);
   const RigidTransform shapePose{smallPose.pointToWorld(approx.shapeCenter()), smallPose.rotation};
   return large.collide(largePose, approx.shape(), shapePose, params, scratch, out, stats);

@@ -83,7 +83,7 @@ void generateQuarry(VoxelTerrain& t, uint32_t seed) {
     throw InvalidInput("generateQuarry: the terrain is " + std::to_string(s.x) + " x " + std::to_string(s.y) + " x " + std::to_string(s.z) +
                        " voxels, at least 32 x 32 x 16 needed");
   SeededRandom r(seed);
-  const int ground = 4, top = s.z * 3 / 4, edge = 4;
+  const int ground = 4, top = s.z * 3 / 4, edge = s.x / 8;
   t.fillBox({0, 0, 0}, {s.x - 1, s.y - 1, ground - 1}, Voxel::make(kMaterialFirstSolid));
   const int cliffFront = s.y - s.y / 5;
   t.fillBox({edge, cliffFront, ground}, {s.x - 1 - edge, s.y - 1, top - 1}, Voxel::make(kMaterialFirstSolid + 1));

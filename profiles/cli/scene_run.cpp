@@ -212,6 +212,10 @@ int runScene(const SceneRunOptions& o) {
   uint64_t pairs = 0, contactCount = 0, boxTests = 0, reused = 0, rayCount = 0, rayHits = 0, rayBoxTests = 0, terrainContacts = 0;
   uint64_t removed = 0, placed = 0, editSkipped = 0, splits = 0, debris = 0;
   Series splitTimes;
+  uint64_t voxelsCarved = 0, terrainParts = 0, debrisVoxels = 0, voxelsSearched = 0;
+  Series terrainEditTimes;  // frames that carved
+  const bool gridEdits = std::any_of(scene.edits.begin(), scene.edits.end(), [](const EditLoadDescription& e) { return !e.grid.empty(); });
+  const bool terrainEdits = std::any_of(scene.edits.begin(), scene.edits.end(), [](const EditLoadDescription& e) { return !e.terrain.empty(); });
   double editMsTotal = 0, editLoadMsTotal = 0;
   uint32_t floating = 0, largestIsland = 0, splitIslands = 0;
   std::ofstream csv;
@@ -254,6 +258,11 @@ int runScene(const SceneRunOptions& o) {
     splits += s.splits;
     debris += s.debrisBricks;
     splitTimes.v.push_back(s.splitMs);
+    voxelsCarved += s.voxelsCarved;
+    terrainParts += s.terrainParts;
+    debrisVoxels += s.debrisVoxels;
+    voxelsSearched += s.voxelsSearched;
+    if (s.voxelsCarved) terrainEditTimes.v.push_back(s.terrainEditMs);
     if (world.render()) render.add(s.render);
     rayCount += s.rays;
     rayHits += s.rayHits;
@@ -342,7 +351,12 @@ int runScene(const SceneRunOptions& o) {
       j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
       j["dynamic_floating"] = floating;
     }
-    if (!scene.edits.empty()) {
+    if (terrainEdits) {
+      j["terrain_edits"] = {{"voxels_carved", voxelsCarved}, {"regions_broken_free", terrainParts}, {"debris_voxels", debrisVoxels},
+                            {"voxels_searched", voxelsSearched}, {"carve_frames", terrainEditTimes.v.size()},
+                            {"median_ms", terrainEditTimes.quantile(0.5)}, {"max_ms", terrainEditTimes.max()}};
+    }
+    if (gridEdits) {
       j["edits"] = stage(edits);
       j["bricks_removed_per_frame"] = double(removed) / frames;
       j["bricks_placed_per_frame"] = double(placed) / frames;
@@ -381,7 +395,7 @@ int runScene(const SceneRunOptions& o) {
   for (auto [name, s] : {std::pair<const char*, const Series*>{"frame", &total}, {"broadphase", &broad}, {"contacts", &contacts},
                          {"solver", &solver}, {"integrate", &integrate}, {"rays", &rays}, {"edits", &edits}}) {
     if (s == &rays && rayCount == 0) continue;
-    if (s == &edits && scene.edits.empty()) continue;
+    if (s == &edits && !gridEdits) continue;
     std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
   }
   std::printf("  simulation %.0f ms; bookkeeping (containment, counters, CSV, work/span, trace) %.0f ms = %.1f%% of it\n",
@@ -393,12 +407,17 @@ int runScene(const SceneRunOptions& o) {
   if (rayCount)
     std::printf("  rays: %.0f per frame, %.1f%% hit, %.0f box tests per ray\n", double(rayCount) / frames,
                 100.0 * double(rayHits) / double(rayCount), double(rayBoxTests) / double(rayCount));
-  if (!scene.edits.empty())
+  if (gridEdits)
     std::printf("  edits: %.0f bricks removed and %.0f placed per frame (%.1f skipped), %.2f us per brick edited (index, mass, "
                 "wakes, caches); the load's own choosing %.3f ms per frame, outside the edit times\n",
                 double(removed) / frames, double(placed) / frames, double(editSkipped) / frames,
                 removed + placed ? 1e3 * editMsTotal / double(removed + placed) : 0.0, editLoadMsTotal / frames);
-  if (!scene.edits.empty() && (splits || debris || splitTimes.max() > 0))
+  if (terrainEdits)
+    std::printf("  terrain edits: %llu voxels carved on %zu frames, %llu regions broke free as bodies, %llu debris voxels gone; the "
+                "cut-off search visited %llu voxels; carve, search and bodies %.3f ms median, %.3f ms max a carving frame\n",
+                (unsigned long long)voxelsCarved, terrainEditTimes.v.size(), (unsigned long long)terrainParts,
+                (unsigned long long)debrisVoxels, (unsigned long long)voxelsSearched, terrainEditTimes.quantile(0.5), terrainEditTimes.max());
+  if (gridEdits && (splits || debris || splitTimes.max() > 0))
     std::printf("  splits: %llu parts became bodies, %llu debris bricks gone; connectivity and splitting %.3f ms median, %.3f ms max a frame\n",
                 (unsigned long long)splits, (unsigned long long)debris, splitTimes.quantile(0.5), splitTimes.max());
   if (!scene.terrains.empty())

@@ -192,6 +192,43 @@ TEST(TerrainContacts, BoxRestingOnGroundIsSupportedAtItsFourCorners) {
   EXPECT_NEAR(contacts[0].depth, -0.1f, 1e-3f);
 }
 
+TEST(TerrainContacts, TumblingBoxesReportTheirDeepestCornerUnderFlatGround) {
+  // Seeded boxes (0.1-0.6 m half sizes) at random rotations, their centres above the ground
+  // and some corner under it, on voxels of 0.5 m far from the origin: the deepest contact
+  // equals the deepest corner (brute force over the 8 corners). note: before the fix, EPA's
+  // depth against a lone ground triangle (a shallow slide off its edge) capped the corners
+  // taken, and 29% of these boxes had a corner sunk up to 0.4 m reported shallower or not at
+  // all: tumbling crates sank into flat ground (quarry).
+  const RigidTransform place{Vec3d(40000, -25000, 120), Quatf::Identity()};
+  Terrain terrain({64, 64, 16}, 0.5f, place);
+  terrain.fillBox({0, 0, 0}, {63, 63, 3}, Voxel::make(2));  // top at local z = 2
+  std::mt19937 rng(17);
+  auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  int underReported = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3f axis = Vec3f(float(uniform(-1, 1)), float(uniform(-1, 1)), float(uniform(-1, 1))).normalized();
+    const Quatf q(Eigen::AngleAxisf(float(uniform(0, M_PI)), axis));
+    const Vec3f half(float(uniform(0.1, 0.6)), float(uniform(0.1, 0.6)), float(uniform(0.1, 0.6)));
+    const Eigen::Matrix3f R = q.toRotationMatrix();
+    const double reach = (R.cwiseAbs() * half).z();
+    const Vec3d local(uniform(8, 24), uniform(8, 24), 2.0 + uniform(0.05, 0.95) * reach);
+    float deepestCorner = 0.f;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3f v((k & 1) ? half.x() : -half.x(), (k & 2) ? half.y() : -half.y(), (k & 4) ? half.z() : -half.z());
+      deepestCorner = std::max(deepestCorner, float(2.0 - (local.z() + (R * v).z())));
+    }
+    std::vector<Contact> out;
+    terrainContacts(terrain, boxAt(place.translation + local, q, half), 0.02f, out);
+    float deepest = -1.f;
+    for (const Contact& c : out) deepest = std::max(deepest, c.depth);
+    if (std::abs(deepest - deepestCorner) > 2e-3f) {
+      ++underReported;
+      ADD_FAILURE() << "box " << i << ": deepest corner " << deepestCorner << " m, deepest contact " << deepest << " m (" << out.size() << " contacts)";
+    }
+  }
+  EXPECT_EQ(underReported, 0);
+}
+
 TEST(TerrainContacts, CapsuleLyingFlatTouchesAtBothEnds) {
   const auto holder = flatTerrain();
   Terrain& terrain = *holder;
