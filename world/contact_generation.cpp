@@ -99,7 +99,8 @@ void World::generateContacts(float dt) {
     if (sa.isGrid() && sb.isGrid() && canCollide(p.a, p.b) && (active(p.a) || active(p.b))) {
       BrickGrid& ga = *grids_[sa.grid];
       BrickGrid& gb = *grids_[sb.grid];
-      (ga.brickCount() <= gb.brickCount() ? ga : gb).convexApproximation(scene_.settings.approximationDepth);
+      BrickGrid& smaller = ga.brickCount() <= gb.brickCount() ? ga : gb;
+      if (smaller.brickCount() > kBrickwiseGridBricks) smaller.convexApproximation(scene_.settings.approximationDepth);  // (else brick by brick)
     }
   }
   // Pair cache: a pair whose relative pose has barely moved reuses its last contacts.

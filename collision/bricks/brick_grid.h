@@ -181,7 +181,8 @@ class BrickGrid {
   float roundingMargin(const Vec3f& queryPoint) const;
 };
 
-/// Grid vs grid (article 000): the grid with fewer bricks collides as its convex approximation
+/// Grid vs grid (article 000): the grid with fewer bricks (of two small ones, the one of smaller
+/// extent) collides as its convex approximation
 /// (box or hull, at `depth`) against the other's bricks; a small grid (at most
 /// kBrickwiseGridBricks bricks) collides brick by brick instead, each brick as the box of its
 /// shape (a wedge or cylinder as its bounding box), so a concave piece (a carved slab, a ring's

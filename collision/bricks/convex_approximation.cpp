@@ -141,7 +141,12 @@ const ConvexApproximation& BrickGrid::convexApproximation(int depth) {
 size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
                     const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
                     ContactStats* stats) {
-  const bool aSmaller = a.brickCount() <= b.brickCount();
+  // By brick count; when both are small enough to go brick by brick, the one of smaller extent
+  // (its bricks against the other's, not a 120 m yard brick against a rubble part's: box vs
+  // brick of such sizes gave 27 m deep contacts, demolition).
+  const bool bothSmall = a.brickCount() <= kBrickwiseGridBricks && b.brickCount() <= kBrickwiseGridBricks;
+  const bool aSmaller = bothSmall ? a.bounds().halfExtent().squaredNorm() <= b.bounds().halfExtent().squaredNorm()
+                                  : a.brickCount() <= b.brickCount();
   smallerIndex = aSmaller ? 0 : 1;
   BrickGrid& small = aSmaller ? a : b;
   const BrickGrid& large = aSmaller ? b : a;

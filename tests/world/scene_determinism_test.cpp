@@ -93,8 +93,8 @@ const std::map<std::string, uint64_t> kRecordedHashes = {
     {"crate_pile", 0x5322832341571e4bull},         {"crates_on_grid", 0xd41fa90ccad74e62ull},
     {"lighthouse", 0x28e12efffa0b9666ull},         {"lighthouse_tiled", 0xd03e38f283555c2aull},
     {"monument", 0x9f298662404df777ull},           {"plate_stack", 0x63c84db239f1dc84ull},
-    {"stack10", 0xba2d80dcf162c060ull},            {"truck_in_station", 0x3a2c28aa04e1eac5ull},
-    {"ship_refit", 0x37d75f4353d6dedbull},         {"demolition", 0x4f9ee65875efd1aaull},
+    {"stack10", 0x435561b2abd83ed3ull},            {"truck_in_station", 0x3a2c28aa04e1eac5ull},
+    {"ship_refit", 0x37d75f4353d6dedbull},         {"demolition", 0xa07b5ecb243bfc76ull},
     {"quarry", 0x96bb93fc3a8de5a1ull},
 };
 
