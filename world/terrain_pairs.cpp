@@ -19,6 +19,7 @@
 // every shipped scene's chunks).
 #include <algorithm>
 
+#include "collision/bricks/brick_narrowphase.h"
 #include "collision/terrain/terrain_contacts.h"
 #include "world/world.h"
 #include "world/world_tuning.h"
@@ -177,6 +178,7 @@ void World::terrainPairs(float dt) {
         join(i, out, faceNormals);
         if (w.bodiesUnique && w.queries[i].wet) buoyancy(w.queries[i]);
       }
+      if (group.queryCount > 1) reduceManifold(out, 0, scene_.settings.manifoldSize);  // a small grid's bricks: one manifold
     }
   });
   ProfileZone z(profiler_, "terrain: apply", stage_ + kTerrainStage + 5);
@@ -199,6 +201,7 @@ void World::terrainPairs(float dt) {
         if (q.brick != TerrainPairWork::kWholeBody)
           for (size_t c = start; c < out.size(); ++c) out[c].featureB = smallFeature(out[c].featureB, q.brick);
       }
+      if (group.queryCount > 1) reduceManifold(out, 0, scene_.settings.manifoldSize);
     }
     stats_.terrainContacts += uint32_t(out.size());
     bool wet = false;

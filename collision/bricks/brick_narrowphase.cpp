@@ -583,4 +583,21 @@ int reduceManifold(LocalContact* c, int n, int maxOut) {
   return out;
 }
 
+void reduceManifold(std::vector<Contact>& out, size_t begin, int maxOut) {
+  const size_t n = out.size() - begin;
+  if (n <= size_t(maxOut)) return;
+  thread_local std::vector<LocalContact> local;
+  local.resize(n);
+  const Vec3d origin = out[begin].position;
+  for (size_t i = 0; i < n; ++i) {
+    const Contact& c = out[begin + i];
+    local[i] = {(c.position - origin).cast<float>(), c.normal, c.depth, c.featureB, c.material, 0};
+  }
+  const int kept = reduceManifold(local.data(), int(n), maxOut);
+  for (int i = 0; i < kept; ++i)
+    out[begin + size_t(i)] = {origin + local[size_t(i)].position.cast<double>(), local[size_t(i)].normal, local[size_t(i)].depth,
+                              local[size_t(i)].feature, local[size_t(i)].material};
+  out.resize(begin + size_t(kept));
+}
+
 }  // namespace bw

@@ -8,8 +8,10 @@
 /// contacts are exact. A non-penetrating pair closer than `speculativeMargin` gives one contact
 /// with negative depth (the gap), for speculative contacts.
 #include <cstdint>
+#include <vector>
 
 #include "collision/bricks/brick.h"
+#include "collision/bricks/contact.h"
 #include "collision/bricks/query_shape.h"
 
 namespace bw {
@@ -68,5 +70,9 @@ constexpr int kManifoldNormalGroups = 4;
 /// returns their count (at most maxOut x kManifoldNormalGroups). Deterministic for a given input
 /// order. n <= maxOut: nothing changes.
 int reduceManifold(LocalContact* contacts, int n, int maxOut);
+
+/// reduceManifold on world-space contacts out[begin, end) (positions taken relative to the first
+/// one's, so far from the origin they keep their float precision); out is cut to the kept ones.
+void reduceManifold(std::vector<Contact>& out, size_t begin, int maxOut);
 
 }  // namespace bw

@@ -154,15 +154,18 @@ size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, con
   const RigidTransform& largePose = aSmaller ? poseB : poseA;
   if (small.brickCount() == 0 || large.brickCount() == 0) return 0;
   if (small.brickCount() <= kBrickwiseGridBricks) {
-    size_t total = 0;
+    // Every brick's manifold, then the pair's reduced as one (by normal direction, then area):
+    // a 100-brick part lying on the ground would otherwise hand the solver 400 contacts.
+    const size_t first = out.size();
     small.forEachBrick([&](uint32_t id) {
       const Brick& br = small.brick(id);
       const RigidTransform pose{smallPose.pointToWorld(br.position), smallPose.rotation * br.rotation.quaternion()};
       const size_t before = out.size();
-      total += large.collide(largePose, QueryShape::box(br.halfSize), pose, params, scratch, out, stats);
+      large.collide(largePose, QueryShape::box(br.halfSize), pose, params, scratch, out, stats);
       for (size_t k = before; k < out.size(); ++k) out[k].featureB = smallFeature(out[k].featureB, id);
     });
-    return total;
+    reduceManifold(out, first, params.maxContacts);
+    return out.size() - first;
   }
   const ConvexApproximation& approx = small.convexApproximation(depth);
   const RigidTransform shapePose{smallPose.pointToWorld(approx.shapeCenter()), smallPose.rotation};
