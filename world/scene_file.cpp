@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "collision/content/build_generators.h"
+#include "collision/content/byte_reader.h"
 #include "collision/terrain/voxel_terrain.h"
 #include "collision/core/argument_checks.h"
 
@@ -152,6 +153,7 @@ std::string contentPath(const Field& f, const std::string& sceneSource, const ch
   if (p.extension() != extension) f.fail(std::string("a path to a ") + extension + " file");
   if (p.is_relative()) p = std::filesystem::path(sceneSource).parent_path() / p;
   std::error_code ec;
+  if (std::filesystem::is_directory(p, ec)) f.failMessage(p.string() + " is a directory, expected a " + extension + " file");
   if (!std::filesystem::is_regular_file(p, ec)) f.failMessage("no such file: " + p.string());
   return p.string();
 }
@@ -373,12 +375,29 @@ EditLoadDescription parseEdit(const Field& f, const std::vector<GridDescription>
 
 }  // namespace
 
+namespace {
+// ":<line>:<column>" of the first occurrence of the literal quoted in a parser message ('...'),
+// or nothing when there is none.
+std::string where(const std::string& text, const std::string& message) {
+  const size_t open = message.find('\''), close = open == std::string::npos ? open : message.find('\'', open + 1);
+  if (close == std::string::npos || close == open + 1) return "";
+  const size_t at = text.find(message.substr(open + 1, close - open - 1));
+  if (at == std::string::npos) return "";
+  const size_t line = size_t(std::count(text.begin(), text.begin() + ptrdiff_t(at), '\n')) + 1;
+  const size_t lineStart = text.rfind('\n', at);
+  return ":" + std::to_string(line) + ":" + std::to_string(at - (lineStart == std::string::npos ? 0 : lineStart + 1) + 1);
+}
+}  // namespace
+
 SceneDescription parseScene(const std::string& jsonText, const std::string& sourceName) {
   json doc;
   try {
     doc = json::parse(jsonText);
   } catch (const json::parse_error& e) {
     throw SceneError(sourceName + ": not valid JSON (" + e.what() + ")");
+  } catch (const json::exception& e) {
+    // A number the parser cannot hold (1e999): its message names the literal, not where it is.
+    throw SceneError(sourceName + where(jsonText, e.what()) + ": not a valid JSON value (" + e.what() + ")");
   }
   const Field root(doc, "scene", sourceName);
   root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays", "attachments", "edits"});
@@ -420,6 +439,11 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
 }
 
 SceneDescription loadScene(const std::string& path) {
+  try {
+    requireRegularFile(path, "a scene (.json)");
+  } catch (const InvalidInput& e) {
+    throw SceneError(e.what());
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path + ": cannot open the scene file");
   std::stringstream text;

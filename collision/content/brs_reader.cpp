@@ -9,6 +9,7 @@
 
 #include "collision/bricks/brick_geometry.h"
 #include "collision/content/brs_asset_mapping.h"
+#include "collision/content/byte_reader.h"
 #include "collision/content/brs_components.h"
 #include "collision/content/brs_format.h"
 #include "collision/core/argument_checks.h"
@@ -246,6 +247,7 @@ BrsLoadResult parseBrs(const uint8_t* data, size_t size, const std::string& name
 }
 
 BrsLoadResult loadBrs(const std::string& path, float unitsPerBrsUnit) {
+  requireRegularFile(path, "a Brickadia .brs save");
   std::ifstream in(path, std::ios::binary);
   if (!in) failFile(path, "file", "cannot be opened");
   in.seekg(0, std::ios::end);

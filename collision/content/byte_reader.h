@@ -21,6 +21,11 @@ namespace bw {
   throw InvalidInput(file + ": " + where + ": " + problem);
 }
 
+/// Throws InvalidInput naming the path when it is missing or is not a regular file (a
+/// directory read as a file gave "larger than 2 GiB" or "not valid JSON"). `expected` says
+/// what it should be ("a .vox model").
+void requireRegularFile(const std::string& path, const std::string& expected);
+
 class ByteReader {
  public:
   /// `container` names the buffer in count errors ("exceeds the data", "exceeds the chunk").

@@ -99,6 +99,7 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
 }
 
 VoxModelSet loadVox(const std::string& path) {
+  requireRegularFile(path, "a MagicaVoxel .vox model");
   std::ifstream in(path, std::ios::binary);
   if (!in) failFile(path, "file", "cannot be opened");
   in.seekg(0, std::ios::end);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cli/command_registry.h"
+#include "cli/output_check.h"
 #include "render_batch/batch_benchmark.h"
 
 namespace bw::cli {
@@ -49,6 +50,7 @@ std::vector<int> defaultThreadCounts() {
 }
 
 int runBatchBench(const Options& o) {
+  requireWritable(o.csv, "--csv");
   const std::string loadBefore = loadAverage();
   std::vector<SubmissionSample> submissions;
   std::vector<TransformLayoutSample> layouts;

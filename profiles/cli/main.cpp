@@ -3,6 +3,7 @@
 #include <exception>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include "cli/command_registry.h"
 
@@ -23,6 +24,14 @@ int main(int argc, char** argv) {
   for (auto& c : registry) {
     CLI::App* sub = app.add_subcommand(c.name, c.description);
     actions.emplace_back(sub, c.setup(*sub));
+  }
+  // An unknown first word: CLI11 would only say "A subcommand is required".
+  if (argc > 1 && argv[1][0] != '-' &&
+      std::none_of(registry.begin(), registry.end(), [&](const CommandInfo& c) { return c.name == argv[1]; })) {
+    std::string names;
+    for (const auto& c : registry) names += (names.empty() ? "" : ", ") + c.name;
+    std::cerr << "brickworld: error: unknown subcommand '" << argv[1] << "' (expected one of: " << names << "; see --help)\n";
+    return 2;
   }
   try {
     app.parse(argc, argv);

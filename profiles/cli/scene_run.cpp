@@ -15,6 +15,7 @@
 #include "cli/progress_watch.h"
 #include "cli/render_figures.h"
 #include "cli/series.h"
+#include "cli/output_check.h"
 #include "world/bullet_baseline.h"
 #include "world/scene_file.h"
 #include "world/world.h"
@@ -198,8 +199,8 @@ int runScene(const SceneRunOptions& o) {
   const SubmissionMode submission = submissionModeFromName(submissionName);
   if (!o.submission.empty() && !scene.attachments.enabled)
     throw SceneError(path + ": --submission " + o.submission + ": the scene declares no attachments (no render thread to submit to)");
-  if (!o.tracePath.empty() && !std::ofstream(o.tracePath))
-    throw std::runtime_error("--trace: cannot write " + o.tracePath);  // checked before the run, not after it
+  requireWritable(o.tracePath, "--trace");
+  requireWritable(o.csvPath, "--csv");
   ProgressWatch watch(o.progress);
   const auto tBuild = Clock::now();
   watch.begin("building the scene");

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "cli/command_registry.h"
+#include "cli/output_check.h"
 #include "cli/render_figures.h"
 #include "cli/scene_run.h"
 #include "world/scene_file.h"
@@ -83,6 +84,7 @@ CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured
       ->check(CLI::IsMember({"batched", "mutex", "concurrent", "all"}));
   cmd.add_flag("--json", *json, "print one JSON object");
   return [=] {
+    requireWritable(*csv, "--csv");
     const std::string path = resolveScenePath(*scene);
     SceneDescription desc = loadScene(path);
     if (!sleeping->empty()) desc.settings.sleeping = *sleeping == "on";

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli/command_registry.h"
+#include "cli/output_check.h"
 #include "cli/scene_run.h"
 #include "world/scene_file.h"
 #include "world/world.h"
@@ -184,6 +185,8 @@ int runTradeoff(const std::string& sceneName, uint32_t framesOption, int threads
                 const std::string& csvPath, bool json) {
   SceneDescription scene = loadScene(resolveScenePath(sceneName));
   if (!sleeping.empty()) scene.settings.sleeping = sleeping == "on";
+  const std::string out = csvPath.empty() ? "tradeoff_" + scene.name + ".csv" : csvPath;
+  requireWritable(out, "--csv");
   const uint32_t frames = framesOption ? framesOption : scene.settings.frames;
   SceneDescription refScene = scene;
   refScene.settings = referenceSettings(scene.settings);
@@ -214,7 +217,6 @@ int runTradeoff(const std::string& sceneName, uint32_t framesOption, int threads
   }
   if (!only.empty() && rows.empty()) throw std::invalid_argument("--knob: no knob named '" + only + "'");
 
-  const std::string out = csvPath.empty() ? "tradeoff_" + scene.name + ".csv" : csvPath;
   std::ofstream csv(out);
   if (!csv) throw std::runtime_error("cannot write " + out);
   csv << "knob,value,median_ms,p95_ms,box_tests_per_frame,contacts_per_frame,penetration_max,penetration_mean,energy_gain,"

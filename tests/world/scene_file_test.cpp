@@ -124,8 +124,34 @@ TEST(SceneFile, MissingFileIsAClearError) {
     loadScene("/nonexistent/scene.json");
     FAIL();
   } catch (const SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.json: cannot open"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.json: file: does not exist"), std::string::npos) << e.what();
   }
+}
+
+TEST(SceneFile, DirectoriesAndOverflowingNumbersNameTheFileAndWhere) {
+  // A directory given as the scene, or as a terrain's .vox: said so (it read as "not valid
+  // JSON" and "larger than 2 GiB").
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "bw_scene_dir_test.json";
+  const std::filesystem::path vox = std::filesystem::temp_directory_path() / "bw_scene_dir_test.vox";
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_directories(vox);
+  const std::pair<std::function<void()>, std::string> cases[] = {
+      {[&] { loadScene(dir.string()); }, dir.string() + ": file: is a directory, expected a scene"},
+      {[&] { parseScene(R"({"name": "x", "terrains": [{"name": "t", "file": ")" + vox.string() + R"("}]})", "s.json"); },
+       "scene.terrains[0].file: " + vox.string() + " is a directory, expected a .vox file"},
+      // 1e999 overflows a double: the parser names the literal, the message its line and column.
+      {[&] { parseScene("{\"name\": \"x\",\n \"settings\": {\"timestep\": 1e999}}", "big.json"); }, "big.json:2:27: not a valid JSON value"},
+  };
+  for (const auto& [run, expected] : cases) {
+    try {
+      run();
+      ADD_FAILURE() << "accepted; expected " << expected;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove(dir);
+  std::filesystem::remove(vox);
 }
 
 TEST(SceneFile, ShippedScenesParse) {
