@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "collision/content/brs_reader.h"
 #include "collision/content/vox_reader.h"
 #include "collision/core/argument_checks.h"
 #include "collision/terrain/terrain.h"
@@ -173,8 +174,24 @@ TEST(VoxBadFiles, MissingFileNamesThePath) {
     loadVox("/nonexistent/dir/model.vox");
     ADD_FAILURE();
   } catch (const InvalidInput& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/model.vox: file: cannot be opened"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/model.vox: file: does not exist"), std::string::npos) << e.what();
   }
+  // A directory is named as one (it read as "larger than 2 GiB"), for .vox and .brs alike.
+  const std::string dir = ::testing::TempDir() + "bw_vox_dir_test.vox";
+  std::filesystem::create_directories(dir);
+  try {
+    loadVox(dir);
+    ADD_FAILURE();
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + ": file: is a directory, expected a MagicaVoxel .vox model"), std::string::npos) << e.what();
+  }
+  try {
+    loadBrs(dir);
+    ADD_FAILURE();
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + ": file: is a directory, expected a Brickadia .brs save"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(dir);
 }
 
 }  // namespace
