@@ -37,6 +37,8 @@ constexpr uint32_t kMaxBatchCapacity = 1u << 28;                 ///< records pe
 constexpr uint32_t kMaxEditsPerFrame = 1'000'000;                ///< bricks or holes per edit stream per frame
 constexpr uint32_t kMaxWallLength = 100'000;                     ///< bricks per course of an edit wall
 constexpr int32_t kMaxGeneratedTerrain = 2048;                   ///< voxels along each axis of a generated terrain
+constexpr uint64_t kMaxTotalBodies = 10'000'000;                 ///< bodies a scene declares in all (grids, copies, primitives, terrains)
+constexpr double kMaxMemoryBudgetMiB = 1 << 24;                  ///< settings.memory_budget_mib (16 TiB)
 }  // namespace scene_limits
 
 /// How a body moves.
@@ -171,6 +173,9 @@ struct SceneSettings {
   int manifoldSize = 4;              ///< contacts kept per pair after reduction (1..64)
   double reuseTranslation = 1e-3;    ///< pair cache: reuse contacts while the relative pose moved
   float reuseRotation = 1e-3f;       ///< less than this (m, rad) since they were made; 0 disables
+  /// The memory a scene may need by its estimate before anything is built (scene_budget.h), in
+  /// MiB; 0: half of this machine's physical memory.
+  double memoryBudgetMiB = 0;
 };
 
 struct SceneDescription {

@@ -244,13 +244,14 @@ SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescriptio
 SceneSettings parseSettings(const Field& f) {
   f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping",
                "manifold_size", "reuse_translation", "reuse_rotation", "relax_iterations", "shock_propagation",
-               "rolling_resistance", "start_in_solid", "depenetration_speed"});
+               "rolling_resistance", "start_in_solid", "depenetration_speed", "memory_budget_mib"});
   SceneSettings s;
   if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-scene_limits::kMaxGravity, scene_limits::kMaxGravity);
   if (f.has("timestep")) s.timestep = f.at("timestep").number(scene_limits::kMinTimestep, scene_limits::kMaxTimestep);
   if (f.has("substeps")) s.substeps = int(f.at("substeps").integer(1, scene_limits::kMaxSubsteps));
   if (f.has("solver_iterations")) s.solverIterations = int(f.at("solver_iterations").integer(1, scene_limits::kMaxSolverIterations));
   if (f.has("frames")) s.frames = uint32_t(f.at("frames").integer(1, 10'000'000));
+  if (f.has("memory_budget_mib")) s.memoryBudgetMiB = f.at("memory_budget_mib").number(1, scene_limits::kMaxMemoryBudgetMiB);
   if (f.has("lod_fraction")) s.lodFraction = float(f.at("lod_fraction").number(0, 1));
   if (f.has("approximation_depth")) s.approximationDepth = int(f.at("approximation_depth").integer(0, scene_limits::kMaxApproximationDepth));
   if (f.has("sleeping")) s.sleeping = f.at("sleeping").boolean();

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string>
 
+#include "world/scene_budget.h"
 #include "world/scene_file.h"
 
 namespace bw {
@@ -48,8 +49,37 @@ class Checker {
 
 }  // namespace
 
+namespace {
+
+std::string mib(uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
+
+// Before anything is built: the totals against the scene limits and the memory budget.
+void checkTotals(const SceneDescription& scene, const Checker& c) {
+  c.number("settings.memory_budget_mib", scene.settings.memoryBudgetMiB, 0, kMaxMemoryBudgetMiB);
+  const SceneTotals t = sceneTotals(scene);
+  const std::string declared = std::to_string(t.bodies) + " bodies in all (" + std::to_string(scene.grids.size()) + " grids, " +
+                               std::to_string(scene.spawners.size()) + " spawners, " + std::to_string(scene.terrains.size()) + " terrains)";
+  if (t.bodies > kMaxTotalBodies)
+    c.message("spawners", "the scene declares " + declared + ", more than the " + std::to_string(kMaxTotalBodies) + " a scene may hold");
+  const uint64_t budget = memoryBudgetBytes(scene.settings);
+  if (t.bytes > budget) {
+    const std::string whose = scene.settings.memoryBudgetMiB > 0 ? "settings.memory_budget_mib"
+                                                                   : "half of this machine's " + mib(physicalMemoryBytes()) +
+                                                                         "; settings.memory_budget_mib sets it";
+    c.message("settings.memory_budget_mib", "the scene needs an estimated " + mib(t.bytes) + " (" + declared + " x " +
+                                                std::to_string(kBytesPerBody) + " B, " + std::to_string(t.listedBricks) +
+                                                " listed bricks x " + std::to_string(kBytesPerListedBrick) + " B, " +
+                                                std::to_string(t.generatedVoxels) + " generated voxels x " +
+                                                std::to_string(kBytesPerGeneratedVoxel) + " B), over the memory budget of " +
+                                                mib(budget) + " (" + whose + ")");
+  }
+}
+
+}  // namespace
+
 void validateScene(const SceneDescription& scene) {
   const Checker c(scene);
+  checkTotals(scene, c);
   const SceneSettings& s = scene.settings;
   c.vector("settings.gravity", s.gravity, -kMaxGravity, kMaxGravity);
   c.number("settings.timestep", s.timestep, kMinTimestep, kMaxTimestep);

@@ -154,6 +154,37 @@ TEST(SceneFile, DirectoriesAndOverflowingNumbersNameTheFileAndWhere) {
   std::filesystem::remove(vox);
 }
 
+TEST(SceneLimits, TotalsOverTheLimitOrTheMemoryBudgetAreRefusedBeforeAnythingIsBuilt) {
+  // 1000 spawners of 10^6 bodies each: every spawner within its own limit, the scene not. It grew
+  // to 6 GB before the fix; now the world refuses it before building a body.
+  auto spawners = [](int n, const char* settings) {
+    std::string text = std::string(R"({"name": "huge", )") + settings + R"("spawners": [)";
+    for (int i = 0; i < n; ++i)
+      text += std::string(i ? "," : "") + R"({"shape": "sphere", "count": 1000000, "radius": 0.2, "region": {"min": [0, 0, 0], "max": [2000, 2000, 200]}, "seed": )" +
+              std::to_string(i) + "}";
+    return text + "]}";
+  };
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {spawners(1000, ""), {"huge.json: spawners: the scene declares 1000000000 bodies in all", "more than the 10000000"}},
+      {spawners(9, R"("settings": {"memory_budget_mib": 1000}, )"),
+       {"huge.json: settings.memory_budget_mib: the scene needs an estimated 5150 MiB", "over the memory budget of 1000 MiB"}},
+  };
+  for (const auto& [text, expected] : cases) {
+    const SceneDescription scene = parseScene(text, "huge.json");  // each field is in range
+    try {
+      World world(scene, 1);
+      ADD_FAILURE() << "built " << world.bodies().size() << " bodies";
+    } catch (const SceneError& e) {
+      for (const std::string& part : expected) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  }
+  // Within the budget it builds: a scene may raise its budget.
+  SceneDescription small = parseScene(spawners(1, R"("settings": {"memory_budget_mib": 1000}, )"), "small.json");
+  small.spawners[0].count = 1000;
+  EXPECT_EQ(World(small, 1).bodies().size(), 1000u);
+  EXPECT_THROW(parseScene(R"({"name": "x", "settings": {"memory_budget_mib": 0}, "spawners": []})", "zero.json"), SceneError);
+}
+
 TEST(SceneFile, ShippedScenesParse) {
   int n = 0;
   for (const auto& entry : std::filesystem::directory_iterator(BW_SCENES_DIR)) {
