@@ -246,6 +246,7 @@ std::map<int32_t, SceneNode> readVoxChunks(const uint8_t* data, size_t size, con
         r.i32("reserved id");
         r.i32("layer id");
         const uint32_t frames = r.count("numFrames", 4);
+        node.frames = std::max(frames, 1u);
         for (uint32_t f = 0; f < frames; ++f) {
           const std::map<std::string, std::string> attrs = r.dict("frame attributes");
           if (f != 0) continue;
@@ -261,6 +262,7 @@ std::map<int32_t, SceneNode> readVoxChunks(const uint8_t* data, size_t size, con
         node.kind = NodeKind::Shape;
         const uint32_t count = r.count("numModels", 8);
         if (count == 0) r.failHere("shape node " + std::to_string(nodeId) + " has no model");
+        node.frames = count;
         for (uint32_t i = 0; i < count; ++i) {
           const int32_t model = r.i32("model id");
           r.dict("model attributes");

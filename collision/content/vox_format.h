@@ -24,6 +24,7 @@ struct SceneNode {
   Int3 translation;               // nTRN frame 0
   bool rotated = false;           // nTRN frame 0 has a non-identity _r
   int32_t model = -1;             // nSHP: first model
+  uint32_t frames = 1;            // nSHP: models listed (animation frames); nTRN: frames listed
 };
 
 // Reads the header, the MAIN chunk and its children into `set`: version, models, palette

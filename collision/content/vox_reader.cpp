@@ -52,8 +52,11 @@ VoxModelSet parseVox(const uint8_t* data, size_t size, const std::string& file) 
   if (set.hasSceneGraph) {
     SceneWalker(nodes, set.models, file).walk(set.instances, set.transformsApplied, set.ignoredRotations);
   } else {
-    for (size_t i = 0; i < set.models.size(); ++i) set.instances.push_back(VoxInstance{uint32_t(i), {}, {}, false});
+    // Several models without a scene graph: an animation's frames (MagicaVoxel 0.98 and earlier).
+    if (!set.models.empty()) set.instances.push_back(VoxInstance{0, {}, {}, false});
+    set.animationFrames = std::max<uint32_t>(1, uint32_t(set.models.size()));
   }
+  for (const auto& [id, node] : nodes) set.animationFrames = std::max(set.animationFrames, node.frames);
 
   // Per-model tight bounds and palette counts once; instances only add them up (a shared model
   // may be placed thousands of times).

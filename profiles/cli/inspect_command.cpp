@@ -57,6 +57,7 @@ int inspectBrs(const std::string& path, bool json) {
     nlohmann::json j;
     j["file"] = path;
     j["format"] = "brs";
+    j["import_scale_m_per_unit"] = 0.04;
     j["version"] = save.version;
     j["game_version"] = save.gameVersion;
     j["map"] = save.mapName;
@@ -93,6 +94,7 @@ int inspectBrs(const std::string& path, bool json) {
   }
 
   std::printf("%s: Brickadia save, format version %d (game %d)\n", path.c_str(), save.version, save.gameVersion);
+  std::printf("  scale       1 Brickadia unit = 0.04 m (a 1 x 1 brick is 0.4 m across; sizes below in metres)\n");
   std::printf("  map \"%s\", author \"%s\"\n", save.mapName.c_str(), save.author.c_str());
   std::printf("  bricks      %u in the file, %zu indexed, %u with collision off, %u of unknown assets\n",
               save.totalBricks, save.bricks.size(), save.collisionOff, save.unknownAssets);
@@ -178,6 +180,8 @@ int inspectVox(const std::string& path, bool json, const std::string& mapFile, c
     j["version"] = set.version;
     j["default_palette"] = set.defaultPalette;
     j["scene_graph"] = set.hasSceneGraph;
+    j["animation_frames"] = set.animationFrames;
+    j["import_scale"] = "1 voxel = voxel_size world units (the scene's terrain voxel_size; 1 here)";
     nlohmann::json models = nlohmann::json::array();
     for (const VoxModel& m : set.models)
       models.push_back({{"size", {m.size.x, m.size.y, m.size.z}}, {"voxels", m.voxels.size()}});
@@ -233,6 +237,9 @@ int inspectVox(const std::string& path, bool json, const std::string& mapFile, c
               set.defaultPalette ? "default" : "own", set.hasSceneGraph ? ", scene graph" : "");
   std::printf("  models      %zu, instances %zu, transforms applied %u, rotations ignored %u, chunks skipped %u\n",
               set.models.size(), set.instances.size(), set.transformsApplied, set.ignoredRotations, set.skippedChunks);
+  std::printf("  scale       1 voxel = 1 world unit here (a scene's terrain sets voxel_size)\n");
+  if (set.animationFrames > 1)
+    std::printf("  animation   %u frames: frame 0 placed, the others not (a terrain is one pose)\n", set.animationFrames);
   for (size_t i = 0; i < set.models.size() && i < 16; ++i)
     std::printf("    model %-4zu %d x %d x %d, %zu voxels\n", i, set.models[i].size.x, set.models[i].size.y,
                 set.models[i].size.z, set.models[i].voxels.size());

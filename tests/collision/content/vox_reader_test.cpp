@@ -215,16 +215,33 @@ TEST(VoxScene, SharedSubtreesInstanceAndRotationsAreCounted) {
   EXPECT_EQ(s.paletteCounts[3], 2u);
 }
 
-TEST(VoxScene, WithoutASceneGraphModelsSitAtTheOrigin) {
-  const Blob file = voxFile({chunk("PACK", Bytes().i32(2).b), sizeChunk(3, 3, 3), xyziChunk({{2, 2, 2, 1}}),
+TEST(VoxScene, WithoutASceneGraphSeveralModelsAreAnimationFramesOfWhichTheFirstIsPlaced) {
+  // MagicaVoxel 0.98 and earlier store an animation as one model a frame (PACK counts them):
+  // T-Rex.vox's 8 frames stacked in one place gave 10,219 voxels where 1,655 distinct exist.
+  const Blob file = voxFile({chunk("PACK", Bytes().i32(2).b), sizeChunk(3, 3, 3), xyziChunk({{2, 2, 2, 1}, {0, 0, 0, 1}}),
                              sizeChunk(5, 1, 1), xyziChunk({{4, 0, 0, 2}})});
   const VoxModelSet s = parseExact(file, "pack.vox");
-  ASSERT_EQ(s.instances.size(), 2u);
-  EXPECT_EQ(s.instances[0].offset, (Int3{0, 0, 0}));
-  EXPECT_EQ(s.instances[1].offset, (Int3{0, 0, 0}));
+  EXPECT_EQ(s.animationFrames, 2u);
+  ASSERT_EQ(s.instances.size(), 1u);
+  EXPECT_EQ(s.instances[0].model, 0u);
+  EXPECT_EQ(s.instances[0].offset, (Int3{0, 0, 0}));  // at the origin, as placed by MagicaVoxel
+  EXPECT_EQ(s.totalVoxels, 2u);
+  EXPECT_EQ(s.fileVoxels, 3u);
   EXPECT_EQ(s.boundsMin, (Int3{0, 0, 0}));
-  EXPECT_EQ(s.boundsMax, (Int3{4, 2, 2}));
+  EXPECT_EQ(s.boundsMax, (Int3{2, 2, 2}));
   EXPECT_EQ(s.transformsApplied, 0u);
+  // One model: no animation.
+  EXPECT_EQ(parseExact(voxFile({sizeChunk(3, 3, 3), xyziChunk({{2, 2, 2, 1}})}), "one.vox").animationFrames, 1u);
+  // With a scene graph, a shape listing three models is a three-frame animation; frame 0 placed.
+  const Blob shape = chunk("nSHP", Bytes().i32(1).dict({}).i32(3).i32(0).dict({}).i32(1).dict({}).i32(1).dict({}).b);
+  const VoxModelSet g = parseExact(voxFile({sizeChunk(3, 3, 3), xyziChunk({{2, 2, 2, 1}}), sizeChunk(5, 1, 1), xyziChunk({{4, 0, 0, 2}}),
+                                            ntrn(0, 1), shape},
+                                           200),
+                                   "frames.vox");
+  EXPECT_EQ(g.animationFrames, 3u);
+  ASSERT_EQ(g.instances.size(), 1u);
+  EXPECT_EQ(g.instances[0].model, 0u);
+  EXPECT_EQ(g.totalVoxels, 1u);
 }
 
 TEST(VoxScene, UnknownChunksAreSkippedBySize) {
