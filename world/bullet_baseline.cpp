@@ -38,11 +38,12 @@ struct BulletBaseline::Impl {
   btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &config};
   BulletBrickShapes brickShapes;                         // expert: shared per distinct brick
   std::vector<std::unique_ptr<BulletChunkedGrid>> grids; // expert: per World grid, shared by its bodies
-  // Expert: what holds a grid's chunks. A static grid body: one static object per chunk (null
-  // while the chunk is empty or after an edit emptied it); a kinematic one: one kinematic body
-  // per chunk, all moved with the grid's pose each frame; a dynamic one: its body's parent
-  // compound, one child per non-empty chunk (slot -1: none).
-  struct StaticHolder {
+  // Expert: what holds a grid's chunks. ObjectHolder: one object per chunk (null while the
+  // chunk is empty or after an edit emptied it): static objects for a static grid body, kinematic
+  // bodies moved with the grid's pose each frame for a kinematic one (KinematicGrids::ChunkBodies).
+  // CompoundHolder: a body whose parent compound holds one child per non-empty chunk (slot -1:
+  // none), for dynamic grids and compound kinematic ones.
+  struct ObjectHolder {
     uint32_t grid;
     btTransform pose;                         // the grid's shape pose (kinematic: now)
     float friction;
@@ -52,24 +53,24 @@ struct BulletBaseline::Impl {
     btTransform bodyPose, shapeFrame;
     btVector3 linearVelocity, angularVelocity;
   };
-  struct MovingHolder {
+  struct CompoundHolder {
     uint32_t grid, body;
     btCompoundShape* parent;
     btTransform shapeFrame;
     std::vector<int> slot;
   };
-  std::vector<StaticHolder> staticHolders;
-  std::vector<MovingHolder> movingHolders;
+  std::vector<ObjectHolder> objectHolders;
+  std::vector<CompoundHolder> compoundHolders;
   std::vector<std::unique_ptr<btCollisionShape>> shapes; // primitives, naive boxes
   std::vector<std::unique_ptr<btCompoundShape>> compounds;
-  std::vector<std::unique_ptr<btCollisionObject>> chunkObjects;  // expert: static grids' chunks (owned; in the world or not)
+  std::vector<std::unique_ptr<btCollisionObject>> chunkObjects;  // expert: chunk objects and bodies (owned; in the world or not)
   float chunkSize = 16.f, restitution = 0.f;
   bool expert = true;
   uint32_t liveChunkObjects = 0;
   double editSeconds = 0;                                // the last applyEdits()
   uint32_t partsMade = 0;
-  bool anyAsleep = false;
-  KinematicGrids kinematicGrids = KinematicGrids::Compound;                                // during applyEdits(): a dynamic body sleeps (else nothing to wake)
+  bool anyAsleep = false;                                // during applyEdits(): a dynamic body sleeps (else nothing to wake)
+  KinematicGrids kinematicGrids = KinematicGrids::Compound;
   std::vector<std::unique_ptr<btDefaultMotionState>> motionStates;
   std::vector<std::unique_ptr<btRigidBody>> bodies;      // per World body; null for a static chunked grid
   std::vector<Vec3d> staticPosition;                     // per World body: where a static one stays
@@ -88,16 +89,16 @@ struct BulletBaseline::Impl {
       if (o->getBroadphaseHandle()) world.removeCollisionObject(o.get());
   }
   float friction(float f) const { return expert ? std::sqrt(f) : f; }  // Bullet multiplies the two objects' (world_tuning.h)
-  void addChunkObject(StaticHolder& h, uint32_t chunk);
-  void refreshChunk(StaticHolder& h, uint32_t chunk);
-  void refreshChunk(MovingHolder& h, uint32_t chunk);
+  void addChunkObject(ObjectHolder& h, uint32_t chunk);
+  void refreshChunk(ObjectHolder& h, uint32_t chunk);
+  void refreshChunk(CompoundHolder& h, uint32_t chunk);
   btCompoundShape* movingGridShape(uint32_t body, uint32_t grid, const btTransform& shapeFrame);
   btRigidBody* addBody(uint32_t body, btCollisionShape* shape, float mass, const btVector3& inertia, float friction,
                        const btTransform& pose);
   void wakeAround(const btVector3& lo, const btVector3& hi);
   static void setChildBox(btCompoundShape& parent, int slot, const btTransform& child);
-  void growParentBox(btCompoundShape& parent, const std::vector<uint32_t>& touched, const MovingHolder& h);
-  void refreshGridBodyMass(MovingHolder& h, const World& judge);
+  void growParentBox(btCompoundShape& parent, const std::vector<uint32_t>& touched, const CompoundHolder& h);
+  void refreshGridBodyMass(CompoundHolder& h, const World& judge);
   void addPartBody(const World& judge, const SplitEdit& split);
 };
 
@@ -119,7 +120,7 @@ std::unique_ptr<btCompoundShape> naiveCompound(const BrickGrid& grid, std::vecto
 }
 }  // namespace
 
-void BulletBaseline::Impl::addChunkObject(StaticHolder& h, uint32_t chunk) {
+void BulletBaseline::Impl::addChunkObject(ObjectHolder& h, uint32_t chunk) {
   const BulletBrickChunk& c = grids[h.grid]->chunks()[chunk];
   if (c.bricks == 0) return;
   const btTransform pose = h.pose * btTransform(btQuaternion::getIdentity(), bt(c.origin));
@@ -149,13 +150,13 @@ btCompoundShape* BulletBaseline::Impl::movingGridShape(uint32_t body, uint32_t g
   // A moving grid: one body whose compound holds its chunk compounds.
   const std::vector<BulletBrickChunk>& chunks = grids[grid]->chunks();
   auto parent = std::make_unique<btCompoundShape>(true, int(chunks.size()));
-  MovingHolder h{grid, body, parent.get(), shapeFrame, std::vector<int>(chunks.size(), -1)};
+  CompoundHolder h{grid, body, parent.get(), shapeFrame, std::vector<int>(chunks.size(), -1)};
   for (uint32_t c = 0; c < chunks.size(); ++c) {
     if (chunks[c].bricks == 0) continue;
     h.slot[c] = parent->getNumChildShapes();
     parent->addChildShape(shapeFrame * btTransform(btQuaternion::getIdentity(), bt(chunks[c].origin)), chunks[c].shape.get());
   }
-  movingHolders.push_back(std::move(h));
+  compoundHolders.push_back(std::move(h));
   compounds.push_back(std::move(parent));
   return compounds.back().get();
 }
@@ -171,9 +172,10 @@ btRigidBody* BulletBaseline::Impl::addBody(uint32_t i, btCollisionShape* shape, 
   return bodies[i].get();
 }
 
-// An edited chunk of a static grid: its object's broadphase box refreshed (Bullet keeps static
-// boxes as they were), the object taken out when the chunk emptied, made when it was new.
-void BulletBaseline::Impl::refreshChunk(StaticHolder& h, uint32_t chunk) {
+// An edited chunk held as an object of its own: a static object's broadphase box refreshed
+// (Bullet keeps static boxes as they were; a kinematic body's is taken each step), the object
+// taken out when the chunk emptied, made when it was new.
+void BulletBaseline::Impl::refreshChunk(ObjectHolder& h, uint32_t chunk) {
   if (h.objects.size() <= chunk) h.objects.resize(grids[h.grid]->chunks().size(), nullptr);
   btCollisionObject* o = h.objects[chunk];
   const bool empty = grids[h.grid]->chunks()[chunk].bricks == 0;
@@ -196,7 +198,7 @@ void BulletBaseline::Impl::refreshChunk(StaticHolder& h, uint32_t chunk) {
 // An edited chunk of a moving grid: its child entry in the parent compound refreshed (the
 // parent's tree holds the child's box), added when new, removed when the chunk emptied (Bullet
 // moves the parent's last child into the slot).
-void BulletBaseline::Impl::refreshChunk(MovingHolder& h, uint32_t chunk) {
+void BulletBaseline::Impl::refreshChunk(CompoundHolder& h, uint32_t chunk) {
   const std::vector<BulletBrickChunk>& chunks = grids[h.grid]->chunks();
   if (h.slot.size() <= chunk) h.slot.resize(chunks.size(), -1);
   const BulletBrickChunk& c = chunks[chunk];
@@ -240,7 +242,7 @@ void BulletBaseline::Impl::setChildBox(btCompoundShape& parent, int slot, const 
 
 // The parent's own box again when a child's box left it (its growth is what the broadphase
 // must see; a box that shrank inside it only stays loose).
-void BulletBaseline::Impl::growParentBox(btCompoundShape& parent, const std::vector<uint32_t>& touched, const MovingHolder& h) {
+void BulletBaseline::Impl::growParentBox(btCompoundShape& parent, const std::vector<uint32_t>& touched, const CompoundHolder& h) {
   btVector3 lo, hi;
   parent.getAabb(btTransform::getIdentity(), lo, hi);
   const std::vector<BulletBrickChunk>& chunks = grids[h.grid]->chunks();
@@ -271,7 +273,7 @@ void BulletBaseline::Impl::wakeAround(const btVector3& lo, const btVector3& hi) 
 // A dynamic grid body after its grid was edited: mass, centre of mass and inertia as the judge
 // computed them (exact, from the grid's running sums, as an expert keeps them too), the body
 // frame moved to the new centre at that point's velocity, every chunk child moved with it.
-void BulletBaseline::Impl::refreshGridBodyMass(MovingHolder& h, const World& judge) {
+void BulletBaseline::Impl::refreshGridBodyMass(CompoundHolder& h, const World& judge) {
   const BodyStore& b = judge.bodies();
   const uint32_t i = h.body;
   btRigidBody& body = *bodies[i];
@@ -299,13 +301,13 @@ void BulletBaseline::Impl::addPartBody(const World& judge, const SplitEdit& spli
   if (grids.size() <= split.grid) grids.resize(split.grid + 1);
   grids[split.grid] = std::make_unique<BulletChunkedGrid>(judge.grid(split.grid), chunkSize, brickShapes);
   btVector3 v(0, 0, 0), w(0, 0, 0);
-  for (const MovingHolder& h : movingHolders)
+  for (const CompoundHolder& h : compoundHolders)
     if (h.grid == split.fromGrid) {
       const btRigidBody& from = *bodies[h.body];
       v = from.getVelocityInLocalPoint(bt(b.position[i]) - from.getCenterOfMassPosition());
       w = from.getAngularVelocity();
     }
-  for (const StaticHolder& h : staticHolders)
+  for (const ObjectHolder& h : objectHolders)
     if (h.kinematic && h.grid == split.fromGrid) {  // a kinematic grid turns about its origin, its position
       w = h.angularVelocity;
       v = h.linearVelocity + w.cross(bt(b.position[i]) - h.bodyPose.getOrigin());
@@ -395,8 +397,8 @@ BulletBaseline::BulletBaseline(const World& w, BulletSetup setup, float chunkSiz
         if (motion == MotionType::Static || (motion == MotionType::Kinematic && kinematic == KinematicGrids::ChunkBodies)) {
           // One object per chunk: a pair walks one chunk's children, not the grid's. A
           // kinematic grid's chunks as kinematic bodies moved together (KinematicGrids).
-          m.staticHolders.push_back({g, bt(b.shapePose(i)), m.friction(b.friction[i]), {}});
-          Impl::StaticHolder& h = m.staticHolders.back();
+          m.objectHolders.push_back({g, bt(b.shapePose(i)), m.friction(b.friction[i]), {}});
+          Impl::ObjectHolder& h = m.objectHolders.back();
           if (motion == MotionType::Kinematic) {
             h.kinematic = true;
             h.body = i;
@@ -486,10 +488,10 @@ void BulletBaseline::applyEdits(const World& judge) {
   }
   for (uint32_t g : edited) {
     const std::vector<uint32_t>& touched = m.grids[g]->finishEdits();
-    for (Impl::StaticHolder& h : m.staticHolders)
+    for (Impl::ObjectHolder& h : m.objectHolders)
       if (h.grid == g)
         for (uint32_t c : touched) m.refreshChunk(h, c);
-    for (Impl::MovingHolder& h : m.movingHolders) {
+    for (Impl::CompoundHolder& h : m.compoundHolders) {
       if (h.grid != g) continue;
       for (uint32_t c : touched) m.refreshChunk(h, c);
       if (m.dynamic[h.body]) m.refreshGridBodyMass(h, judge);
@@ -520,7 +522,7 @@ void BulletBaseline::step() {
                                         btScalar(m.timestep), next);
     static_cast<btDefaultMotionState*>(body.getMotionState())->setWorldTransform(next);
   }
-  for (Impl::StaticHolder& h : m.staticHolders) {
+  for (Impl::ObjectHolder& h : m.objectHolders) {
     if (!h.kinematic) continue;
     btTransform next;
     btTransformUtil::integrateTransform(h.bodyPose, h.linearVelocity, h.angularVelocity, btScalar(m.timestep), next);
@@ -573,7 +575,7 @@ void BulletBaseline::poses(std::vector<Vec3d>& positions, std::vector<Quatf>& ro
     positions[i] = Vec3d(p.x(), p.y(), p.z());
     rotations[i] = Quatf(q.w(), q.x(), q.y(), q.z()).normalized();
   }
-  for (const Impl::StaticHolder& h : m.staticHolders) {
+  for (const Impl::ObjectHolder& h : m.objectHolders) {
     if (!h.kinematic) continue;
     const btVector3& p = h.bodyPose.getOrigin();
     const btQuaternion q = h.bodyPose.getRotation();
