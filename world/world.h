@@ -16,10 +16,14 @@
 /// starting matched by contact feature, a relax pass after integration), islands solved in
 /// parallel, islands above kSplitContacts coloured (no two contacts of a colour share a dynamic
 /// body) and solved colour by colour on every thread, sleeping, and substeps; per-body stages,
-/// solver preparation and island building run in parallel too. Terrain pairs run
-/// on one thread (the chunk cache is filled by queries); water voxels float bodies. Bodies that
-/// start inside solid are pushed out or refused (depenetration.h). Thread safety: one step()
-/// at a time; editGrid() and probeContacts() only between steps.
+/// solver preparation and island building run in parallel too. Terrain pairs are planned from
+/// cached chunk meshes and collided in pieces in parallel (the cache is filled on one thread);
+/// water voxels float bodies. Grids of up to kBrickwiseGridBricks bricks meet grids and
+/// terrains brick by brick. Each step first makes the scene's edits (edit_load.h), splits parts
+/// that lost their joints into bodies, carves terrains and lets cut-off regions break free
+/// (terrain_breaks.cpp). Bodies that start inside solid are pushed out or refused
+/// (depenetration.h). Thread safety: one step() at a time; editGrid() and probeContacts() only
+/// between steps.
 #include <cstdint>
 #include <memory>
 #include <span>
