@@ -152,6 +152,12 @@ void World::terrainPairs(float dt) {
   // A query's contacts: its pieces joined in order, interior edges and repeats dropped, appended
   // to its pair's list (a small grid's bricks one after another); a query planned from chunks
   // not in the cache runs whole the filling way (apply stage). Either way the same contacts.
+  // A small grid's brick query: its contacts' features mix in the brick (warm starting tells
+  // the bricks apart).
+  const auto markBrick = [](const TerrainPairWork::Query& q, std::vector<Contact>& out, size_t start) {
+    if (q.brick == TerrainPairWork::kWholeBody) return;
+    for (size_t c = start; c < out.size(); ++c) out[c].featureB = smallFeature(out[c].featureB, q.brick);
+  };
   const auto join = [&](uint32_t i, std::vector<Contact>& out, std::vector<Vec3f>& faceNormals) {
     const TerrainPairWork::Query& q = w.queries[i];
     const size_t start = out.size();
@@ -162,8 +168,7 @@ void World::terrainPairs(float dt) {
       faceNormals.insert(faceNormals.end(), o.faceNormals.begin(), o.faceNormals.end());
     }
     finishTerrainContacts(out, start, faceNormals);
-    if (q.brick != TerrainPairWork::kWholeBody)
-      for (size_t c = start; c < out.size(); ++c) out[c].featureB = smallFeature(out[c].featureB, q.brick);
+    markBrick(q, out, start);
   };
   const uint32_t groupCount = uint32_t(w.groups.size());
   jobs_.parallelFor(0, groupCount, grainFor(groupCount, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
@@ -198,8 +203,7 @@ void World::terrainPairs(float dt) {
         }
         const size_t start = out.size();
         terrainContacts(*terrains_[q.terrain], q.shape, q.pose, q.margin, out);
-        if (q.brick != TerrainPairWork::kWholeBody)
-          for (size_t c = start; c < out.size(); ++c) out[c].featureB = smallFeature(out[c].featureB, q.brick);
+        markBrick(q, out, start);
       }
       if (group.queryCount > 1) reduceManifold(out, 0, scene_.settings.manifoldSize);
     }
