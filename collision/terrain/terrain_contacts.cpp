@@ -73,7 +73,7 @@ LocalShape placeShape(const QueryShape& s, const Vec3f& centre, const Quatf& rot
 /// half under flat ground had their deepest corner reported shallower or not at all
 /// (terrain_contacts_test, TumblingBoxes...).
 int convexTriangle(const btConvexShape& convex, const btTransform& xf, const LocalShape& shape, const Vec3f& a,
-                   const Vec3f& b, const Vec3f& c, const Vec3f& n, float spec, LocalContact* out, int maxOut) {
+                   const Vec3f& b, const Vec3f& c, const Vec3f& n, float spec, TriangleContact* out, int maxOut) {
   // Reject early when the whole shape is behind the face or beyond reach of its plane.
   const float sdCentre = n.dot(shape.centre - a);
   const float reach = shape.halfBounds.dot(n.cwiseAbs());
@@ -122,7 +122,7 @@ int convexTriangle(const btConvexShape& convex, const btTransform& xf, const Loc
   btPointCollector res;
   gjk.getClosestPoints(in, res, nullptr);
   if (!res.m_hasResult || res.m_distance > spec) return 0;
-  LocalContact gjkContact{fromBt(res.m_pointInWorld), fromBt(res.m_normalOnBInWorld), -float(res.m_distance)};
+  TriangleContact gjkContact{fromBt(res.m_pointInWorld), fromBt(res.m_normalOnBInWorld), -float(res.m_distance)};
   const Vec3f centreOnPlane = shape.centre - sdCentre * n;
   if (gjkContact.normal.dot(n) < 0.f && (closestPointOnTriangle(centreOnPlane, a, b, c) - centreOnPlane).squaredNorm() <= tol * tol) {
     // Normal points into the solid with the shape's centre behind the face itself: push out
@@ -302,7 +302,7 @@ void TerrainContactPlan::contactsOfTriangles(uint32_t begin, uint32_t end, std::
     const float len = cr.norm();
     if (!(len > 0.f)) continue;
     const Vec3f n = cr / len;
-    LocalContact lc[8];
+    TriangleContact lc[8];
     int k = 0;
     switch (shape.kind) {
       case QueryShape::Kind::Sphere:
@@ -310,7 +310,7 @@ void TerrainContactPlan::contactsOfTriangles(uint32_t begin, uint32_t end, std::
         break;
       case QueryShape::Kind::Capsule: {
         const Vec3f axis = ls.rot.col(2) * shape.halfHeight;
-        LocalContact two[2];
+        TriangleContact two[2];
         k = capsuleTriangle(ls.centre - axis, ls.centre + axis, shape.radius, a, b, c, n, spec_, two);
         std::copy(two, two + k, lc);
         break;

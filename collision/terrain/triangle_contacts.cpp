@@ -51,7 +51,7 @@ Vec3f closestPointOnTriangle(const Vec3f& p, const Vec3f& a, const Vec3f& b, con
 
 /// One-sided sphere/triangle contact. `n` is the triangle's unit outward normal.
 bool sphereTriangle(const Vec3f& centre, float r, const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec3f& n,
-                    float spec, LocalContact& out) {
+                    float spec, TriangleContact& out) {
   const float sd = n.dot(centre - a);
   if (sd < -r || sd > r + spec) return false;  // wholly behind the face, or out of reach
   const Vec3f p = closestPointOnTriangle(centre, a, b, c);
@@ -74,7 +74,7 @@ bool sphereTriangle(const Vec3f& centre, float r, const Vec3f& a, const Vec3f& b
 /// Capsule/triangle: both end spheres (two points for a capsule lying on a face); if neither
 /// touches, the sphere at the core point closest to the triangle (edge contacts).
 int capsuleTriangle(const Vec3f& p0, const Vec3f& p1, float r, const Vec3f& a, const Vec3f& b, const Vec3f& c,
-                    const Vec3f& n, float spec, LocalContact (&out)[2]) {
+                    const Vec3f& n, float spec, TriangleContact (&out)[2]) {
   int k = 0;
   if (sphereTriangle(p0, r, a, b, c, n, spec, out[k])) ++k;
   if (sphereTriangle(p1, r, a, b, c, n, spec, out[k])) ++k;

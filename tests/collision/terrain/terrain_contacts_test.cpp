@@ -64,7 +64,7 @@ TEST(TerrainContacts, SphereContactsMatchBruteForceOverAllTriangles) {
     std::vector<Vec3f> faces;
     for (size_t t = 0; t < tris.size(); t += 3) {
       const Vec3f nrm = (tris[t + 1] - tris[t]).cross(tris[t + 2] - tris[t]).normalized();
-      LocalContact lc;
+      TriangleContact lc;
       if (sphereTriangle(c, r, tris[t], tris[t + 1], tris[t + 2], nrm, 0.05f, lc)) {
         brute.push_back({lc.point.cast<double>(), lc.normal, lc.depth, 0, 0});
         faces.push_back(nrm);
