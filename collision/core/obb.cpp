@@ -1,10 +1,15 @@
 #include "collision/core/obb.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace bw {
 
-bool overlaps(const Obb& a, const Aabb& b) {
+namespace {
+
+// The separating-axis test; an axis separates when the projections' gap exceeds slack.
+bool satOverlap(const Obb& a, const Aabb& b, float slack) {
   const Vec3f bc = b.center();
   const Vec3f bh = b.halfExtent();
   const Mat3f& R = a.axes;  // a's axes expressed in b's (world-aligned) frame
@@ -17,12 +22,12 @@ bool overlaps(const Obb& a, const Aabb& b) {
   // b's face axes (world x, y, z)
   for (int i = 0; i < 3; ++i) {
     const float ra = absR.row(i).dot(a.half);
-    if (std::abs(t[i]) > ra + bh[i]) return false;
+    if (std::abs(t[i]) > ra + bh[i] + slack) return false;
   }
   // a's face axes
   for (int j = 0; j < 3; ++j) {
     const float rb = absR.col(j).dot(bh);
-    if (std::abs(R.col(j).dot(t)) > a.half[j] + rb) return false;
+    if (std::abs(R.col(j).dot(t)) > a.half[j] + rb + slack) return false;
   }
   // cross products of b's axis i with a's axis j
   for (int i = 0; i < 3; ++i) {
@@ -32,10 +37,23 @@ bool overlaps(const Obb& a, const Aabb& b) {
       const float ra = a.half[j1] * absR(i, j2) + a.half[j2] * absR(i, j1);
       const float rb = bh[i1] * absR(i2, j) + bh[i2] * absR(i1, j);
       const float d = t[i2] * R(i1, j) - t[i1] * R(i2, j);
-      if (std::abs(d) > ra + rb) return false;
+      if (std::abs(d) > ra + rb + slack) return false;
     }
   }
   return true;
+}
+
+}  // namespace
+
+bool overlaps(const Obb& a, const Aabb& b) { return satOverlap(a, b, 0.f); }
+
+bool mayOverlap(const Obb& a, const Aabb& b) {
+  // Every quantity the test compares is a sum of a few products of values no larger than the
+  // largest coordinate or extent (rotation entries are <= 1); each rounding is half an ulp of
+  // that, so 16 ulps of it cover the centre, difference, projection and sum roundings together.
+  const float scale = std::max({a.center.cwiseAbs().maxCoeff(), b.min.cwiseAbs().maxCoeff(), b.max.cwiseAbs().maxCoeff(),
+                                a.half.maxCoeff()});
+  return satOverlap(a, b, scale * (16.f * std::numeric_limits<float>::epsilon()));
 }
 
 }  // namespace bw

@@ -24,4 +24,12 @@ struct Obb {
 /// never separate boxes that the face axes say overlap.
 bool overlaps(const Obb& a, const Aabb& b);
 
+/// The same test with slack for the float rounding of its own arithmetic (a few ulps of the
+/// largest coordinate involved), for culling a tree node: the 15 axes' projections are not
+/// monotone in the box, so at 10^6 m a node's tight bounds could test separated while an
+/// element inside them tests overlapping (found by the OctoBVH fuzz target: a flat box rotated
+/// against a flat element, both at x = -1002816). Never false when overlaps(a, c) is true for
+/// some box c inside b.
+bool mayOverlap(const Obb& a, const Aabb& b);
+
 }  // namespace bw

@@ -61,9 +61,11 @@ void LooseOctree::overlap(const Aabb& box, uint32_t mask, F&& f, QueryStats* sta
 template <class F, class Exact>
 void LooseOctree::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stats, Exact&& exact) const {
   const Aabb outer = box.bounds();
-  walkOverlap(mask, stats, [&](const Aabb& b) { return b.overlaps(outer) && bw::overlaps(box, b); },
+  // note: cubes and elements both pass the rounding-tolerant test (obb.h mayOverlap: a cube
+  // must not be culled when an element inside it overlaps); elements then the exact one.
+  walkOverlap(mask, stats, [&](const Aabb& b) { return b.overlaps(outer) && bw::mayOverlap(box, b); },
               [&](uint32_t e, const Aabb& b) {
-                if (exact(e, b)) f(e);
+                if (bw::overlaps(box, b) && exact(e, b)) f(e);
               });
 }
 

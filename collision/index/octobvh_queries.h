@@ -116,7 +116,7 @@ void OctoBvh::overlap(const Obb& box, uint32_t mask, F&& f, QueryStats* stats, E
         const Aabb eb = r.bounds();
         if (eb.overlaps(outer) && bw::overlaps(box, eb) && exact(e, eb)) f(e);
       },
-      [&](uint32_t c, int o) { return bw::overlaps(box, clusters_[c].bounds(o)); });
+      [&](uint32_t c, int o) { return bw::mayOverlap(box, clusters_[c].bounds(o)); });
 }
 
 template <class F, class L>

@@ -226,3 +226,46 @@ TEST(ExtremesBadInput, OctoBvhCoordinateLimitIsExactAndRefusalsChangeNothing) {
 
 }  // namespace
 }  // namespace bw
+
+namespace bw {
+namespace {
+
+// Flat boxes (one extent rounded to zero) around 10^6 m, queried by flat oriented boxes:
+// the separating-axis test rounds differently on a node's bounds than on an element inside
+// them, and culled nodes holding overlapping elements (found by fuzz_octobvh_edits: a box
+// rotated against an element at x = -1002816). Nodes are now culled by mayOverlap.
+TEST(ExtremesOctoBvh, FlatOrientedBoxesFarFromTheOriginFindWhatBruteForceFinds) {
+  SeededRandom r(21);
+  OctoBvh tree;
+  test::BruteForceIndex ref;
+  const Vec3f anchor(-1e6f, -1e6f, -1e6f);
+  auto lattice = [&](float step) {
+    return Vec3f(anchor.x() + float(int(r.below(64)) - 32) * step, anchor.y() + float(int(r.below(64)) - 32) * step,
+                 anchor.z() + float(int(r.below(64)) - 32) * step);
+  };
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3f c = lattice(0.5f);
+    Vec3f h(float(r.logUniform(0.001, 8)), float(r.logUniform(0.001, 8)), float(r.logUniform(0.001, 8)));
+    h[int(r.below(3))] = 0.f;  // flat
+    const Aabb b{c - h, c + h};
+    ref.items[tree.insert(b, 1, uint32_t(i))] = {b, 1};
+  }
+  int found = 0;
+  for (int q = 0; q < 4000; ++q) {
+    Obb obb;
+    obb.center = lattice(0.5f);
+    obb.half = Vec3f(float(r.logUniform(0.001, 8)), float(r.logUniform(0.001, 8)), float(r.logUniform(0.001, 8)));
+    obb.half[int(r.below(3))] = 0.f;
+    obb.axes = Eigen::AngleAxisf(float(r.uniform(0, 6.28)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized())
+                   .toRotationMatrix();
+    std::vector<uint32_t> got;
+    tree.overlap(obb, 1, got);
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, ref.overlap(obb, 1)) << "query " << q;
+    found += int(!got.empty());
+  }
+  EXPECT_GT(found, 400);
+}
+
+}  // namespace
+}  // namespace bw
