@@ -2,6 +2,7 @@
 /// Exact geometry of brick shapes: vertices, face planes, bounds, mass moments, ray clipping.
 /// Canonical shapes are described in brick.h; everything here is exact for every shape and
 /// rotation (rotations are signed permutations).
+#include <cmath>
 #include <cstdint>
 
 #include "collision/bricks/brick.h"
@@ -44,6 +45,36 @@ struct ShapeMoments {
     second -= o.second;
   }
 };
+/// A running sum of moments as bricks come and go, with Neumaier's compensation on each of its
+/// 13 entries. note: a plain sum keeps the rounding of everything it ever held: a 10^4 m slab
+/// placed and removed again left 1e-4 of error in a 7e4 mass (the grid-edit fuzz target), and
+/// a grid of small bricks that lost its big foundation could be left with any mass at all.
+class MomentSum {
+ public:
+  void add(const ShapeMoments& m) { accumulate(m, 1.0); }
+  void subtract(const ShapeMoments& m) { accumulate(m, -1.0); }
+  void clear() { sum_ = comp_ = ShapeMoments{}; }
+  /// The sum with its compensation applied.
+  ShapeMoments value() const {
+    ShapeMoments v = sum_;
+    v += comp_;
+    return v;
+  }
+
+ private:
+  static void twoSum(double& s, double& c, double x) {
+    const double t = s + x;
+    c += std::abs(s) >= std::abs(x) ? (s - t) + x : (x - t) + s;
+    s = t;
+  }
+  void accumulate(const ShapeMoments& m, double sign) {
+    twoSum(sum_.volume, comp_.volume, sign * m.volume);
+    for (int i = 0; i < 3; ++i) twoSum(sum_.first[i], comp_.first[i], sign * m.first[i]);
+    for (int i = 0; i < 9; ++i) twoSum(sum_.second.data()[i], comp_.second.data()[i], sign * m.second.data()[i]);
+  }
+  ShapeMoments sum_, comp_;
+};
+
 /// Moments of the canonical shape (about its box centre, unrotated).
 ShapeMoments canonicalBrickMoments(const Brick& b);
 /// Moments of the placed brick about `reference` in the grid frame, scaled by density.

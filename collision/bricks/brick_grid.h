@@ -168,7 +168,7 @@ class BrickGrid {
   Config config_;
   ParallelVirtualPool<Brick, uint32_t> bricks_;  // brick, OctoBVH element handle
   OctoBvh index_;
-  ShapeMoments moments_;                         // about reference_
+  MomentSum moments_;                            // about reference_
   Vec3d reference_ = Vec3d::Zero();
   bool referenceSet_ = false;
   uint64_t edits_ = 0;
@@ -179,6 +179,7 @@ class BrickGrid {
   std::array<CachedApproximation, 8> approximations_;
 
   float roundingMargin(const Vec3f& queryPoint) const;
+  void rebaseIfCancelling();
 };
 
 /// Grid vs grid (article 000): the grid with fewer bricks (of two small ones, the one of smaller
