@@ -398,6 +398,7 @@ uint32_t World::addPartBody(std::unique_ptr<BrickGrid> grid, std::unique_ptr<Bri
   gridBodies_.push_back({body});
   solidBodies_.push_back(body);
   nearSolid_.push_back(1);
+  ghost_.push_back(0);  // note: read for every pair while some body depenetrates (a part made then overran it)
   sleep_.grow(bodies_.size());
   return body;
 }
