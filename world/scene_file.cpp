@@ -128,7 +128,10 @@ Brick parseBrick(const Field& f) {
   f.allowOnly({"position", "half_size", "shape", "rotation", "material", "filter", "sides"});
   Brick b;
   b.position = f.at("position").vec3(-1e8, 1e8).cast<float>();
-  b.halfSize = f.at("half_size").vec3(kMinBrickHalfSize, 1e6).cast<float>();
+  // note: the bound as written (0.002), not the float kMinBrickHalfSize (0.0020000000949...):
+  // against the float, "0.002" was refused with "expected [0.002, ...], got 0.002". It rounds
+  // to kMinBrickHalfSize itself, which grids accept.
+  b.halfSize = f.at("half_size").vec3(0.002, 1e6).cast<float>();
   if (f.has("shape")) {
     const std::string s = f.at("shape").oneOf({"box", "wedge", "corner_wedge", "cylinder"});
     b.shape = s == "box" ? BrickShape::Box : s == "wedge" ? BrickShape::Wedge : s == "corner_wedge" ? BrickShape::CornerWedge : BrickShape::Cylinder;
