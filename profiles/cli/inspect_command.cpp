@@ -17,6 +17,7 @@
 #include "cli/command_registry.h"
 #include "collision/bricks/brick_grid.h"
 #include "collision/content/brs_reader.h"
+#include "collision/core/errors.h"
 #include "collision/content/vox_reader.h"
 #include "collision/core/argument_checks.h"
 
@@ -290,8 +291,11 @@ CommandRegistration reg{"inspect",
   cmd.add_option("--materials", *materials, ".vox: a JSON palette -> material mapping file (see vox_reader.h)");
   cmd.add_option("--top", *top, ".vox: palette indices listed, most used first")->capture_default_str();
   return [=] {
-    if (lowerExtension(*file) == ".vox") return inspectVox(*file, *json, *materials, *water, *top);
-    return inspectBrs(*file, *json);
+    const std::string ext = lowerExtension(*file);
+    if (ext == ".vox") return inspectVox(*file, *json, *materials, *water, *top);
+    if (ext == ".brs") return inspectBrs(*file, *json);
+    throw InvalidInput(*file + ": expected a Brickadia save (.brs) or a MagicaVoxel model (.vox), got a '" + ext +
+                       "' file (a scene runs with `brickworld run`)");
   };
 }};
 

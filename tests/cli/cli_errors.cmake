@@ -18,3 +18,4 @@ expect_failure("--csv: cannot write /nonexistent/dir/r.csv" run city_rain --fram
 expect_failure("--csv: cannot write /nonexistent/dir/s.csv" sweep stack10 --frames 1 --csv /nonexistent/dir/s.csv)
 expect_failure("--csv: cannot write /nonexistent/dir/t.csv" tradeoff stack10 --frames 1 --csv /nonexistent/dir/t.csv)
 expect_failure("--csv: cannot write /nonexistent/dir/b.csv" batch-bench --csv /nonexistent/dir/b.csv)
+expect_failure("expected a Brickadia save (.brs) or a MagicaVoxel model (.vox), got a '.json' file" inspect ${SCENES}/stack10.json)
