@@ -146,6 +146,12 @@ void EditLoad::carve(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats
 
 void EditLoad::wall(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st) {
   const Vec3f h = s.d.brickHalfSize;
+  if (grid.brickCount() == 0) {
+    // Nothing to stand on (its bricks were all removed): the wall waits. note: its empty bounds
+    // gave a NaN brick (the scene fuzz target).
+    st.skipped += s.d.perFrame;
+    return;
+  }
   if (!s.wallStarted) {
     // On top of the grid, along x, at a seeded y inside its bounds.
     const Aabb b = grid.bounds();
