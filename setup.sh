@@ -5,6 +5,7 @@ set -euo pipefail
 packages=(
   g++ cmake ninja-build make git
   clang                # the determinism check: a clang build gives GCC's state hashes
+  libclang-rt-14-dev   # libFuzzer and the sanitizer runtimes for clang (the fuzz preset)
   libeigen3-dev        # Eigen 3.4: math types
   libbullet-dev        # Bullet 3.24: narrowphase primitives and the baseline
   libtbb-dev           # oneTBB 2021: jobs

@@ -13,6 +13,14 @@ elseif(BW_SANITIZE STREQUAL "thread")
 elseif(NOT BW_SANITIZE STREQUAL "")
   message(FATAL_ERROR "BW_SANITIZE must be empty, address or thread (got '${BW_SANITIZE}')")
 endif()
+# The fuzz preset: every library instrumented for libFuzzer's coverage feedback (the targets in
+# tests/fuzz link the fuzzer runtime itself). clang only.
+if(BW_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "BW_FUZZ needs clang (libFuzzer): use the fuzz preset")
+  endif()
+  target_compile_options(bw_build_options INTERFACE -fsanitize=fuzzer-no-link)
+endif()
 # note: the 24 axis rotations' composition table is computed at compile time; clang's default
 # constexpr step limit stops short of it.
 if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
