@@ -1,3 +1,4 @@
+#include <bit>
 #include "collision/bricks/brick_geometry.h"
 
 #include <cmath>
@@ -85,6 +86,84 @@ int canonicalBrickVertices(const Brick& b, Vec3f* out) {
     }
   }
   return 0;
+}
+
+int clipBrickToBox(const Brick& b, const Aabb& region, Vec3f* out, int maxOut) {
+  BrickPlane canonical[kMaxBrickPlanes];
+  const int nb = canonicalBrickPlanes(b, canonical);
+  Vec3f cv[kMaxBrickVertices];
+  const int nv = canonicalBrickVertices(b, cv);
+  // Which canonical planes each vertex lies on (in the canonical frame, where both are exact to
+  // float rounding): two vertices sharing two planes bound an edge (or a segment of a face,
+  // which adds points inside the part, never outside it).
+  const float onPlane = 1e-5f * (1.f + b.halfSize.maxCoeff());
+  uint64_t faces[kMaxBrickVertices];
+  for (int i = 0; i < nv; ++i) {
+    faces[i] = 0;
+    for (int k = 0; k < nb && k < 64; ++k)
+      if (std::abs(canonical[k].n.dot(cv[i]) - canonical[k].d) <= onPlane) faces[i] |= uint64_t(1) << k;
+  }
+  // Planes n . y <= d and vertices, relative to the region's centre, in double.
+  const Vec3d c = region.center().cast<double>();
+  const Vec3d h = region.halfExtent().cast<double>();
+  const Mat3d r = b.rotation.matrix().cast<double>();
+  const Vec3d offset = b.position.cast<double>() - c;
+  Vec3d n[kMaxBrickPlanes];
+  double d[kMaxBrickPlanes];
+  for (int k = 0; k < nb; ++k) {
+    n[k] = r * canonical[k].n.cast<double>();
+    d[k] = double(canonical[k].d) + n[k].dot(offset);
+  }
+  Vec3d v[kMaxBrickVertices];
+  for (int i = 0; i < nv; ++i) v[i] = r * cv[i].cast<double>() + offset;
+  const double tolerance = 1e-6 * (1.0 + h.maxCoeff());
+  auto inBrick = [&](const Vec3d& y) {
+    for (int k = 0; k < nb; ++k)
+      if (n[k].dot(y) > d[k] + tolerance) return false;
+    return true;
+  };
+  auto inRegion = [&](const Vec3d& y) { return (y.cwiseAbs() - h).maxCoeff() <= tolerance; };
+  int count = 0;
+  auto add = [&](const Vec3d& y) {
+    const Vec3f p = y.cast<float>();
+    for (int q = 0; q < count; ++q)
+      if ((out[q] - p).squaredNorm() < float(tolerance * tolerance) * 4.f) return;
+    if (count < maxOut) out[count++] = p;
+  };
+  for (int i = 0; i < nv; ++i)
+    if (inRegion(v[i])) add(v[i]);
+  for (int k = 0; k < 8; ++k) {
+    const Vec3d corner((k & 1) ? h.x() : -h.x(), (k & 2) ? h.y() : -h.y(), (k & 4) ? h.z() : -h.z());
+    if (inBrick(corner)) add(corner);
+  }
+  // b's edges through the region's faces.
+  for (int i = 0; i < nv; ++i)
+    for (int j = i + 1; j < nv; ++j) {
+      if (std::popcount(faces[i] & faces[j]) < 2) continue;
+      for (int a = 0; a < 3; ++a)
+        for (const double side : {-h[a], h[a]}) {
+          const double si = v[i][a] - side, sj = v[j][a] - side;
+          if ((si < 0) == (sj < 0) || si == sj) continue;
+          const Vec3d y = v[i] + (v[j] - v[i]) * (si / (si - sj));
+          if (inRegion(y)) add(y);
+        }
+    }
+  // The region's edges through b's faces: along axis a, at the other two axes' +-h.
+  for (int a = 0; a < 3; ++a) {
+    const int u = (a + 1) % 3, w = (a + 2) % 3;
+    for (int e = 0; e < 4; ++e) {
+      Vec3d p0 = Vec3d::Zero();
+      p0[u] = (e & 1) ? h[u] : -h[u];
+      p0[w] = (e & 2) ? h[w] : -h[w];
+      for (int k = 0; k < nb; ++k) {
+        if (std::abs(n[k][a]) < 1e-12) continue;
+        Vec3d y = p0;
+        y[a] = (d[k] - n[k].dot(p0)) / n[k][a];  // p0 has 0 along a
+        if (std::abs(y[a]) <= h[a] + tolerance && inBrick(y)) add(y);
+      }
+    }
+  }
+  return count;
 }
 
 int canonicalBrickPlanes(const Brick& b, BrickPlane* out) {

@@ -23,6 +23,13 @@ struct BrickPlane {
 int canonicalBrickVertices(const Brick& b, Vec3f* out);
 /// Face planes of the canonical shape (the shape is their intersection). Returns the count.
 int canonicalBrickPlanes(const Brick& b, BrickPlane* out);
+/// Vertices of the part of brick b inside the box `region` (grid frame), relative to the
+/// region's centre (computed in double: a brick hundreds of metres long and a small region far
+/// from its centre), for GJK on huge bricks: b's vertices inside the region, the region's
+/// corners inside b, b's edges through the region's faces and the region's edges through b's
+/// faces, duplicates (within 1e-6 of the region's size) dropped. At most maxOut; 0 when they do
+/// not meet. For bricks of up to 12 face planes (callers keep bigger cylinders whole).
+int clipBrickToBox(const Brick& b, const Aabb& region, Vec3f* out, int maxOut);
 /// Vertices in the grid frame (rotated and placed). Returns the count.
 int brickVertices(const Brick& b, Vec3f* out);
 /// Exact grid-local bounds of the brick's shape.
