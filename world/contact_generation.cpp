@@ -100,7 +100,9 @@ void World::generateContacts(float dt) {
       BrickGrid& ga = *grids_[sa.grid];
       BrickGrid& gb = *grids_[sb.grid];
       BrickGrid& smaller = ga.brickCount() <= gb.brickCount() ? ga : gb;
-      if (smaller.brickCount() > kBrickwiseGridBricks) smaller.convexApproximation(scene_.settings.approximationDepth);  // (else brick by brick)
+      // (else brick by brick; and two-way grid pairs need no hull)
+      if (smaller.brickCount() > kBrickwiseGridBricks && scene_.settings.gridPairs != GridPairMode::TwoWay)
+        smaller.convexApproximation(scene_.settings.approximationDepth);
     }
   }
   // Pair cache: a pair whose relative pose has barely moved reuses its last contacts.
@@ -130,7 +132,7 @@ void World::generateContacts(float dt) {
       if (sa.isGrid() && sb.isGrid()) {
         int smaller = 0;
         collideGrids(*grids_[sa.grid], bodies_.shapePose(a), *grids_[sb.grid], bodies_.shapePose(b),
-                     scene_.settings.approximationDepth, params, scratch_[k], out, smaller, &pairStats_[k]);
+                     scene_.settings.approximationDepth, params, scratch_[k], out, smaller, &pairStats_[k], scene_.settings.gridPairs);
         pairFlipped_[k] = smaller == 1;  // normals point from the larger (a) to the smaller (b)
       } else if (sa.isGrid() || sb.isGrid()) {
         const uint32_t g = sa.isGrid() ? a : b, p = sa.isGrid() ? b : a;

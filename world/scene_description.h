@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "collision/bricks/brick.h"
+#include "collision/bricks/grid_pair.h"
 #include "collision/core/math_types.h"
 #include "collision/terrain/voxel_chunk.h"
 
@@ -169,6 +170,9 @@ struct SceneSettings {
   uint32_t frames = 300;
   float lodFraction = 1.f / 16;
   int approximationDepth = 3;
+  /// Grid against grid (grid_pair.h): "convex" (the smaller grid's hull), "two_way" (bricks
+  /// against bricks) or "auto" (two-way when the hull overstates the bricks by kAutoTwoWayFill).
+  GridPairMode gridPairs = GridPairMode::Convex;
   bool sleeping = true;
   int manifoldSize = 4;              ///< contacts kept per pair after reduction (1..64)
   double reuseTranslation = 1e-3;    ///< pair cache: reuse contacts while the relative pose moved

@@ -247,7 +247,7 @@ SpawnerDescription parseSpawner(const Field& f, const std::vector<GridDescriptio
 SceneSettings parseSettings(const Field& f) {
   f.allowOnly({"gravity", "timestep", "substeps", "solver_iterations", "frames", "lod_fraction", "approximation_depth", "sleeping",
                "manifold_size", "reuse_translation", "reuse_rotation", "relax_iterations", "shock_propagation",
-               "rolling_resistance", "start_in_solid", "depenetration_speed", "memory_budget_mib"});
+               "rolling_resistance", "start_in_solid", "depenetration_speed", "memory_budget_mib", "grid_pairs"});
   SceneSettings s;
   if (f.has("gravity")) s.gravity = f.at("gravity").vec3(-scene_limits::kMaxGravity, scene_limits::kMaxGravity);
   if (f.has("timestep")) s.timestep = f.at("timestep").number(scene_limits::kMinTimestep, scene_limits::kMaxTimestep);
@@ -259,6 +259,10 @@ SceneSettings parseSettings(const Field& f) {
   if (f.has("approximation_depth")) s.approximationDepth = int(f.at("approximation_depth").integer(0, scene_limits::kMaxApproximationDepth));
   if (f.has("sleeping")) s.sleeping = f.at("sleeping").boolean();
   if (f.has("shock_propagation")) s.shockPropagation = f.at("shock_propagation").boolean();
+  if (f.has("grid_pairs")) {
+    const std::string mode = f.at("grid_pairs").oneOf({"convex", "two_way", "auto"});
+    s.gridPairs = mode == "convex" ? GridPairMode::Convex : mode == "two_way" ? GridPairMode::TwoWay : GridPairMode::Auto;
+  }
   if (f.has("relax_iterations")) s.relaxIterations = int(f.at("relax_iterations").integer(0, scene_limits::kMaxRelaxIterations));
   if (f.has("start_in_solid")) {
     const std::string policy = f.at("start_in_solid").oneOf({"push_out", "refuse"});

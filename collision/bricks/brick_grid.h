@@ -20,6 +20,7 @@
 #include "collision/bricks/brick_geometry.h"
 #include "collision/bricks/brick_narrowphase.h"
 #include "collision/bricks/contact.h"
+#include "collision/bricks/grid_pair.h"
 #include "collision/core/ids.h"
 #include "collision/core/rigid_transform.h"
 #include "collision/index/octobvh.h"
@@ -69,6 +70,8 @@ struct ContactStats {
 /// Reusable buffers for contact queries (one per thread): no allocation once warmed up.
 struct ContactScratch {
   std::vector<LocalContact> raw;
+  GridPairScratch pair;                      ///< two-way grid pairs (collideGrids)
+  std::vector<GridPairContact> pairContacts;
 };
 
 /// A grid's convex stand-in for grid-vs-grid collision (grid frame).
@@ -78,6 +81,7 @@ struct ConvexApproximation {
   std::vector<Vec3f> vertices;    ///< hull vertices (the 8 corners when isBox)
   std::vector<Vec3f> centered;    ///< the same relative to shapeCenter(), for shape()
   double hullVolume = 0;
+  double brickVolume = 0;         ///< the bricks' own volume (the hull's fill: hullVolume / this)
   int depth = 0;
   uint32_t inputPoints = 0;       ///< points handed to the hull computer
   QueryShape shape() const;       ///< as a query shape (box centred on the bounds, or hull)
@@ -190,7 +194,10 @@ class BrickGrid {
 /// part) is not filled in by its hull; each contact's feature then mixes in the small grid's
 /// brick (smallFeature), so warm starting tells the bricks apart. Contacts are world-space
 /// with normals pointing from `larger` towards `smaller`; returns which grid was treated as the
-/// smaller (0 = a, 1 = b) through smallerIndex.
+/// smaller (0 = a, 1 = b) through smallerIndex. `mode` TwoWay (or Auto with a hull overstating
+/// the smaller grid's bricks by kAutoTwoWayFill) collides a smaller grid above
+/// kBrickwiseGridBricks brick against brick instead (collideGridPair, the LOD at
+/// params.lodFraction on both sides), the pair's contacts reduced as one manifold.
 /// Bricks up to which a grid collides brick by brick against grids and terrains (collideGrids,
 /// the world's terrain pairs): above it the hull's one query is cheaper than the bricks' many.
 constexpr uint32_t kBrickwiseGridBricks = 128;
@@ -199,6 +206,6 @@ inline uint32_t smallFeature(uint32_t feature, uint32_t brick) { return feature 
 
 size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
                     const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
-                    ContactStats* stats = nullptr);
+                    ContactStats* stats = nullptr, GridPairMode mode = GridPairMode::Convex);
 
 }  // namespace bw

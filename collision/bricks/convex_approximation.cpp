@@ -88,6 +88,7 @@ ConvexApproximation BrickGrid::buildConvexApproximation(int depth) const {
   std::vector<Vec3f> pts;
   collectPoints(*this, index_.rootCluster(), 0, 0, depth, pts);
   a.inputPoints = uint32_t(pts.size());
+  forEachBrick([&](uint32_t id) { a.brickVolume += canonicalBrickMoments(brick(id)).volume; });
   btConvexHullComputer hull;
   hull.compute(pts[0].data(), int(sizeof(Vec3f)), int(pts.size()), 0, 0);
   for (int i = 0; i < hull.vertices.size(); ++i) {
@@ -140,7 +141,7 @@ const ConvexApproximation& BrickGrid::convexApproximation(int depth) {
 
 size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
                     const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
-                    ContactStats* stats) {
+                    ContactStats* stats, GridPairMode mode) {
   // By brick count; when both are small enough to go brick by brick, the one of smaller extent
   // (its bricks against the other's, not a 120 m yard brick against a rubble part's: box vs
   // brick of such sizes gave 27 m deep contacts, demolition).
@@ -164,6 +165,34 @@ size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, con
       large.collide(largePose, QueryShape::box(br.halfSize), pose, params, scratch, out, stats);
       for (size_t k = before; k < out.size(); ++k) out[k].featureB = smallFeature(out[k].featureB, id);
     });
+    reduceManifold(out, first, params.maxContacts);
+    return out.size() - first;
+  }
+  const bool twoWay = mode == GridPairMode::TwoWay || (mode == GridPairMode::Auto && [&] {
+                        const ConvexApproximation& a = small.convexApproximation(depth);
+                        return a.hullVolume > kAutoTwoWayFill * a.brickVolume;
+                      }());
+  if (twoWay) {
+    // Both grids' bricks, in the large grid's frame (the relative pose formed in double once).
+    const LocalPose smallInLarge{largePose.pointToLocal(smallPose.translation), largePose.rotationToLocal(smallPose.rotation)};
+    GridPairParams pairParams;
+    pairParams.lodFraction = params.lodFraction;
+    pairParams.speculativeMargin = params.speculativeMargin;
+    scratch.pairContacts.clear();
+    GridPairStats pairStats;
+    collideGridPair(small, large, smallInLarge, pairParams, scratch.pair, scratch.pairContacts, &pairStats);
+    const size_t first = out.size();
+    for (const GridPairContact& c : scratch.pairContacts) {
+      const uint32_t material = (c.brickB & kLodFeature) ? 0u : large.brick(c.brickB).material;
+      out.push_back({largePose.pointToWorld(c.position), largePose.directionToWorld(c.normal), c.depth, smallFeature(c.brickB, c.brickA),
+                     material});
+    }
+    if (stats) {
+      stats->index.boxTests += pairStats.itemPairs;
+      stats->bricksTested += uint32_t(pairStats.brickPairs);
+      stats->lodBoxes += uint32_t(pairStats.lodBoxes);
+      stats->rawContacts += uint32_t(scratch.pairContacts.size());
+    }
     reduceManifold(out, first, params.maxContacts);
     return out.size() - first;
   }

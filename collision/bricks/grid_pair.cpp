@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "collision/bricks/brick_geometry.h"
+#include "collision/bricks/brick_grid.h"
 #include "collision/core/obb.h"
 
 namespace bw {

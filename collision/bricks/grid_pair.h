@@ -22,10 +22,20 @@
 #include <cstdint>
 #include <vector>
 
-#include "collision/bricks/brick_grid.h"
+#include "collision/bricks/brick.h"
 #include "collision/bricks/brick_narrowphase.h"
 
 namespace bw {
+
+class BrickGrid;
+
+/// How a grid pair collides (scene setting `grid_pairs`): the smaller grid's convex
+/// approximation against the other's bricks (article 000's one-way path), both grids' bricks
+/// (collideGridPair), or two-way when the approximation overstates the smaller grid's bricks by
+/// more than kAutoTwoWayFill (a ring, a hangar, an L-shaped wall: holes and recesses filled in).
+enum class GridPairMode : uint8_t { Convex, TwoWay, Auto };
+/// Auto: two-way when the hull's volume exceeds the bricks' by this factor.
+constexpr double kAutoTwoWayFill = 1.5;
 
 struct GridPairParams {
   float lodFraction = 1.f / 16;   ///< subtrees smaller than this x the other side's item are boxes (0: off)

@@ -22,6 +22,7 @@
 
 #include "collision/bricks/brick_grid.h"
 #include "collision/bricks/bullet_brick_shapes.h"
+#include "collision/bricks/brick_grid.h"
 #include "collision/bricks/grid_pair.h"
 #include "collision/content/build_generators.h"
 #include "collision/core/seeded_random.h"

@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "collision/bricks/brick_geometry.h"
+#include "collision/bricks/brick_grid.h"
 #include "collision/bricks/grid_pair.h"
 #include "collision/core/seeded_random.h"
 
@@ -173,6 +174,52 @@ TEST(GridPair, LodNeverLeavesATouchingPairWithoutContacts) {
     }
   }
   EXPECT_GT(touching, 20);
+}
+
+}  // namespace
+}  // namespace bw
+
+namespace bw {
+namespace {
+
+// collideGrids with the two-way and automatic modes: the linked rings (hull fill far above
+// kAutoTwoWayFill) go brick against brick in both, so nothing touches; the convex mode's hull
+// does; a solid slab (fill 1) stays convex under auto.
+TEST(GridPair, CollideGridsModesChooseTwoWayForHollowGrids) {
+  BrickGrid a, b;
+  ring(a, 1, Vec3f(0, 0, 0));
+  ring(b, 0, Vec3f(0, 0, 0));
+  const RigidTransform poseA{Vec3d(100.0, -50.0, 2.0), Quatf::Identity()}, poseB{Vec3d(100.0, -50.0, 0.0), Quatf::Identity()};
+  const ConvexApproximation& hull = a.convexApproximation(3);
+  EXPECT_GT(hull.hullVolume, kAutoTwoWayFill * hull.brickVolume);
+  ContactParams params;
+  ContactScratch scratch;
+  std::vector<Contact> out;
+  int smaller = 0;
+  for (GridPairMode mode : {GridPairMode::TwoWay, GridPairMode::Auto}) {
+    out.clear();
+    collideGrids(a, poseA, b, poseB, 3, params, scratch, out, smaller, nullptr, mode);
+    EXPECT_TRUE(std::none_of(out.begin(), out.end(), [](const Contact& c) { return c.depth > 0; })) << int(mode);
+  }
+  out.clear();
+  collideGrids(a, poseA, b, poseB, 3, params, scratch, out, smaller, nullptr, GridPairMode::Convex);
+  EXPECT_TRUE(std::any_of(out.begin(), out.end(), [](const Contact& c) { return c.depth > 0.05f; }));
+  // Lowered to b's centre height: both rings' upper bars cross at z = 2 and lower bars at z =
+  // -2; the two-way contacts are world-space, on b's bars, at most the manifold after reduction.
+  out.clear();
+  const RigidTransform lowered{Vec3d(100.0, -50.0, 0.02), Quatf::Identity()};
+  collideGrids(a, lowered, b, poseB, 3, params, scratch, out, smaller, nullptr, GridPairMode::TwoWay);
+  ASSERT_FALSE(out.empty());
+  EXPECT_LE(out.size(), size_t(params.maxContacts * kManifoldNormalGroups));
+  for (const Contact& c : out) {
+    EXPECT_NEAR(c.position.x(), 100.0, 2.5);
+    EXPECT_NEAR(std::abs(c.position.z()), 2.0, 0.1);
+  }
+  // A solid slab of 4x4x2 bricks: its hull is its bricks, so auto keeps the convex path.
+  BrickGrid slab;
+  for (int i = 0; i < 200; ++i) slab.placeBrick(Brick::box(Vec3f(float(i % 10), float((i / 10) % 10), float(i / 100)), Vec3f::Constant(0.5f)));
+  const ConvexApproximation& solid = slab.convexApproximation(3);
+  EXPECT_LE(solid.hullVolume, kAutoTwoWayFill * solid.brickVolume);
 }
 
 }  // namespace
