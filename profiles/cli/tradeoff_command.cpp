@@ -41,6 +41,8 @@ const std::vector<Knob>& knobs() {
       {"solver_iterations", {2, 4, 8, 16, 32}, [](SceneSettings& s, double v) { s.solverIterations = int(v); }},
       {"substeps", {1, 2, 4}, [](SceneSettings& s, double v) { s.substeps = int(v); }},
       {"manifold_size", {1, 2, 4, 8}, [](SceneSettings& s, double v) { s.manifoldSize = int(v); }},
+      // 0 convex, 1 two-way, 2 auto (GridPairMode)
+      {"grid_pairs", {0, 1, 2}, [](SceneSettings& s, double v) { s.gridPairs = GridPairMode(int(v)); }},
       {"pair_cache_tolerance", {0, 1e-4, 1e-3, 1e-2},
        [](SceneSettings& s, double v) {
          s.reuseTranslation = v;
@@ -51,7 +53,7 @@ const std::vector<Knob>& knobs() {
 }
 
 // The most accurate settings: no LOD, deep approximations, many iterations and substeps, big
-// manifolds, no pair cache. Sleeping stays as the scene says (it changes what is simulated).
+// manifolds, no pair cache, grids against grids brick against brick. Sleeping stays as the scene says (it changes what is simulated).
 SceneSettings referenceSettings(SceneSettings s) {
   s.lodFraction = 0;
   s.approximationDepth = 5;
@@ -60,6 +62,7 @@ SceneSettings referenceSettings(SceneSettings s) {
   s.manifoldSize = 8;
   s.reuseTranslation = 0;
   s.reuseRotation = 0;
+  s.gridPairs = GridPairMode::TwoWay;
   return s;
 }
 
@@ -273,7 +276,7 @@ CommandRegistration reg{"tradeoff", "Cost against error for each speed/accuracy 
   cmd.add_option("--frames", *frames, "frames per run (default: the scene's)")->check(CLI::Range(1u, 10'000'000u));
   cmd.add_option("--threads", *threads, "threads (default 1)")->check(CLI::Range(1, 1024));
   cmd.add_option("--knob", *knob, "only this knob (lod_fraction, approximation_depth, solver_iterations, substeps, manifold_size, "
-                                  "pair_cache_tolerance)");
+                                  "grid_pairs (0 convex, 1 two-way, 2 auto), pair_cache_tolerance)");
   cmd.add_option("--csv", *csv, "CSV to write (default tradeoff_<scene>.csv)");
   cmd.add_flag("--json", *json, "print one JSON object");
   return [=] { return runTradeoff(*scene, *frames, *threads, *knob, *sleeping, *csv, *json); };
