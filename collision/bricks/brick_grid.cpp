@@ -47,6 +47,7 @@ uint32_t BrickGrid::placeBrick(const Brick& b) {
     referenceSet_ = true;
   }
   moments_.add(brickMoments(b, config_.density[b.material], reference_));
+  peakSecond_ = std::max(peakSecond_, moments_.value().second.trace());
   ++edits_;
   return id;
 }
@@ -81,6 +82,7 @@ std::vector<uint32_t> BrickGrid::placeBricks(const std::vector<Brick>& bricks) {
     }
     moments_.add(brickMoments(bricks[i], config_.density[bricks[i].material], reference_));
   }
+  peakSecond_ = std::max(peakSecond_, moments_.value().second.trace());
   ++edits_;
   return ids;
 }
@@ -93,6 +95,7 @@ void BrickGrid::removeBrick(uint32_t id) {
   bricks_.free(id);
   if (bricks_.size() == 0) {
     moments_.clear();  // exactly empty
+    peakSecond_ = 0;
     referenceSet_ = false;
   } else {
     moments_.subtract(brickMoments(b, config_.density[b.material], reference_));
@@ -108,20 +111,24 @@ void BrickGrid::removeBrick(uint32_t id) {
 // kRebaseRatio of the spread (about 20 bits lost), the sums are recomputed about the centre of
 // mass: O(bricks), after which the centre must move by a thousand radii of gyration, which
 // takes edits of most of the mass, before it happens again.
+// note: the compensated sums keep an error of about eps^2 times the largest value they ever
+// held; once what is left is 2^-30 of that peak (a 10^4 m brick came and went among 1 mm ones:
+// 1e-3 of their inertia, the grid-edit fuzz target again), they are recomputed as well.
 void BrickGrid::rebaseIfCancelling() {
-  constexpr double kRebaseRatio = double(1 << 20);
+  constexpr double kRebaseRatio = double(1 << 20), kPeakRatio = double(1 << 30);
   const ShapeMoments sum = moments_.value();
   if (sum.volume <= 0) return;
   const Vec3d comRel = sum.first / sum.volume;
   const double offset = sum.volume * comRel.squaredNorm();
   const double spread = sum.second.trace() - offset;  // sum of m |x - centre|^2
-  if (offset <= kRebaseRatio * spread) return;
+  if (offset <= kRebaseRatio * spread && sum.second.trace() * kPeakRatio >= peakSecond_) return;
   reference_ += comRel;
   moments_.clear();
   bricks_.forEachLive([&](uint32_t id) {
     const Brick& b = bricks_.get<0>(id);
     moments_.add(brickMoments(b, config_.density[b.material], reference_));
   });
+  peakSecond_ = moments_.value().second.trace();
 }
 
 MassProperties BrickGrid::massProperties() const {

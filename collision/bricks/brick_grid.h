@@ -173,6 +173,7 @@ class BrickGrid {
   ParallelVirtualPool<Brick, uint32_t> bricks_;  // brick, OctoBVH element handle
   OctoBvh index_;
   MomentSum moments_;                            // about reference_
+  double peakSecond_ = 0;                        // largest trace of the second moment since the last recompute
   Vec3d reference_ = Vec3d::Zero();
   bool referenceSet_ = false;
   uint64_t edits_ = 0;
