@@ -55,10 +55,12 @@ std::string World::bodySource(uint32_t body) const {
 }
 
 float World::deepestStaticOverlap(uint32_t body, const Vec3d& position, ContactScratch& scratch, std::vector<Contact>& contacts) {
-  RigidTransform pose = RigidTransform{position, bodies_.rotation[body]} * bodies_.shapeFromBody[body];
+  const RigidTransform gridPose = RigidTransform{position, bodies_.rotation[body]} * bodies_.shapeFromBody[body];
+  RigidTransform pose = gridPose;
   QueryShape shape = bodies_.shape[body].primitive;
-  if (bodies_.shape[body].isGrid()) {
-    // A grid meets other grids and terrain through its convex approximation (as in a step).
+  const bool isGrid = bodies_.shape[body].isGrid();
+  if (isGrid) {
+    // A grid meets terrain through its convex approximation (as in a step).
     const ConvexApproximation& hull = grids_[bodies_.shape[body].grid]->convexApproximation(scene_.settings.approximationDepth);
     pose.translation = pose.pointToWorld(hull.shapeCenter());
     shape = hull.shape();
@@ -70,7 +72,13 @@ float World::deepestStaticOverlap(uint32_t body, const Vec3d& position, ContactS
   for (uint32_t g : solidBodies_) {
     if (g == body) continue;
     contacts.clear();
-    if (bodies_.shape[g].isGrid()) {
+    if (bodies_.shape[g].isGrid() && isGrid) {
+      // Grid against grid as a step pairs them (the scene's grid_pairs): two interlocked chain
+      // links overlap as hulls but not as bricks.
+      int smaller = 0;
+      collideGrids(*grids_[bodies_.shape[g].grid], bodies_.shapePose(g), *grids_[bodies_.shape[body].grid], gridPose,
+                   scene_.settings.approximationDepth, params, scratch, contacts, smaller, nullptr, scene_.settings.gridPairs);
+    } else if (bodies_.shape[g].isGrid()) {
       grids_[bodies_.shape[g].grid]->collide(bodies_.shapePose(g), shape, pose, params, scratch, contacts);
     } else if (bodies_.shape[g].isTerrain()) {
       terrainContacts(*terrains_[bodies_.shape[g].terrain], shape, pose, 0.f, contacts);

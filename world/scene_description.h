@@ -182,6 +182,21 @@ struct SceneSettings {
   double memoryBudgetMiB = 0;
 };
 
+/// What a run checks besides containment (scene_checks.h), for scenes whose point is a shape
+/// of motion: chains that must stay linked, ships that must get somewhere.
+struct SceneChecks {
+  /// Each entry names grids in chain order; each must stay linked to the next (their
+  /// oriented bounds overlap at every frame: a link that passed through another falls away).
+  std::vector<std::vector<std::string>> linked;
+  /// A grid whose centre of mass (its origin when static or kinematic) must end inside a box.
+  struct EndsIn {
+    std::string grid;
+    Vec3d min = Vec3d::Zero(), max = Vec3d::Zero();  ///< world box
+  };
+  std::vector<EndsIn> endsIn;
+  bool empty() const { return linked.empty() && endsIn.empty(); }
+};
+
 struct SceneDescription {
   std::string name;
   std::string source;  ///< file it came from
@@ -192,6 +207,7 @@ struct SceneDescription {
   RayLoadDescription rays;
   AttachmentsDescription attachments;
   std::vector<EditLoadDescription> edits;
+  SceneChecks checks;
 };
 
 }  // namespace bw

@@ -381,6 +381,50 @@ EditLoadDescription parseEdit(const Field& f, const std::vector<GridDescription>
   return e;
 }
 
+// A grid name that must be declared in "grids".
+std::string gridName(const Field& f, const std::vector<GridDescription>& grids) {
+  const std::string name = f.string();
+  if (std::none_of(grids.begin(), grids.end(), [&](const GridDescription& d) { return d.name == name; }))
+    f.fail("the name of a grid declared in \"grids\"");
+  return name;
+}
+
+SceneChecks parseChecks(const Field& f, const std::vector<GridDescription>& grids) {
+  f.allowOnly({"linked", "ends_in"});
+  SceneChecks c;
+  if (f.has("linked")) {
+    const Field chains = f.at("linked");
+    const size_t n = chains.arraySize(1'000);
+    for (size_t i = 0; i < n; ++i) {
+      const Field chain = chains.index(i);
+      const size_t links = chain.arraySize(100'000);
+      if (links < 2) chain.fail("an array of at least 2 grid names (a chain in order)");
+      std::set<std::string> seen;
+      c.linked.emplace_back();
+      for (size_t k = 0; k < links; ++k) {
+        c.linked.back().push_back(gridName(chain.index(k), grids));
+        if (!seen.insert(c.linked.back().back()).second) chain.index(k).fail("a grid not already in this chain");
+      }
+    }
+  }
+  if (f.has("ends_in")) {
+    const Field list = f.at("ends_in");
+    const size_t n = list.arraySize(1'000);
+    for (size_t i = 0; i < n; ++i) {
+      const Field e = list.index(i);
+      e.allowOnly({"grid", "min", "max"});
+      SceneChecks::EndsIn end;
+      end.grid = gridName(e.at("grid"), grids);
+      end.min = e.at("min").vec3(-kMaxCoord, kMaxCoord);
+      end.max = e.at("max").vec3(-kMaxCoord, kMaxCoord);
+      for (int a = 0; a < 3; ++a)
+        if (end.min[a] > end.max[a]) e.failMessage(std::string("min.") + "xyz"[a] + " is greater than max." + "xyz"[a]);
+      c.endsIn.push_back(end);
+    }
+  }
+  return c;
+}
+
 }  // namespace
 
 namespace {
@@ -408,7 +452,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     throw SceneError(sourceName + where(jsonText, e.what()) + ": not a valid JSON value (" + e.what() + ")");
   }
   const Field root(doc, "scene", sourceName);
-  root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays", "attachments", "edits"});
+  root.allowOnly({"name", "description", "settings", "grids", "spawners", "terrains", "rays", "attachments", "edits", "checks"});
   SceneDescription scene;
   scene.source = sourceName;
   scene.name = root.at("name").string();
@@ -441,6 +485,7 @@ SceneDescription parseScene(const std::string& jsonText, const std::string& sour
     const size_t n = edits.arraySize(1'000);
     for (size_t i = 0; i < n; ++i) scene.edits.push_back(parseEdit(edits.index(i), scene.grids, scene.terrains));
   }
+  if (root.has("checks")) scene.checks = parseChecks(root.at("checks"), scene.grids);
   if (scene.grids.empty() && scene.spawners.empty() && scene.terrains.empty())
     root.failMessage("declares no grids, spawners or terrains: nothing to simulate");
   return scene;

@@ -175,6 +175,28 @@ void validateScene(const SceneDescription& scene) {
     c.vector(f + ".brick_half_size", e.brickHalfSize, kMinSize, kMaxSize);
     c.number(f + ".wall_length", e.wallLength, 1, kMaxWallLength);
   }
+  auto declared = [&](const std::string& name) {
+    return std::any_of(scene.grids.begin(), scene.grids.end(), [&](const GridDescription& g) { return g.name == name; });
+  };
+  for (size_t i = 0; i < scene.checks.linked.size(); ++i) {
+    const std::vector<std::string>& chain = scene.checks.linked[i];
+    const std::string f = "checks.linked[" + std::to_string(i) + "]";
+    if (chain.size() < 2) c.message(f, "expected at least 2 grid names (a chain in order)");
+    for (size_t k = 0; k < chain.size(); ++k) {
+      if (!declared(chain[k])) c.message(f + "[" + std::to_string(k) + "]", "expected the name of a grid declared in grids, got '" + chain[k] + "'");
+      if (std::find(chain.begin(), chain.begin() + ptrdiff_t(k), chain[k]) != chain.begin() + ptrdiff_t(k))
+        c.message(f + "[" + std::to_string(k) + "]", "'" + chain[k] + "' is already in this chain");
+    }
+  }
+  for (size_t i = 0; i < scene.checks.endsIn.size(); ++i) {
+    const SceneChecks::EndsIn& e = scene.checks.endsIn[i];
+    const std::string f = "checks.ends_in[" + std::to_string(i) + "]";
+    if (!declared(e.grid)) c.message(f + ".grid", "expected the name of a grid declared in grids, got '" + e.grid + "'");
+    c.vector(f + ".min", e.min, -kMaxCoordinate, kMaxCoordinate);
+    c.vector(f + ".max", e.max, -kMaxCoordinate, kMaxCoordinate);
+    for (int a = 0; a < 3; ++a)
+      if (e.min[a] > e.max[a]) c.message(f, "min is above max along " + std::string(1, "xyz"[a]));
+  }
   if (scene.attachments.enabled) {
     c.number("attachments.render_chunk", scene.attachments.renderChunk, kMinRenderChunk, kMaxRenderChunk);
     c.number("attachments.batch_capacity.primitives", scene.attachments.batchPrimitives, 0, kMaxBatchCapacity);

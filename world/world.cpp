@@ -9,6 +9,7 @@
 #include "collision/core/argument_checks.h"
 #include "collision/core/hash.h"
 #include "world/body_mass.h"
+#include "world/scene_file.h"
 #include "world/scene_validation.h"
 #include "world/world_tuning.h"
 
@@ -64,6 +65,16 @@ const BrickGrid& World::grid(uint32_t index) const {
   if (index >= grids_.size())
     throw InvalidInput("World::grid: index is " + std::to_string(index) + ", the world has " + std::to_string(grids_.size()) + " grids");
   return *grids_[index];
+}
+
+uint32_t World::gridBody(const std::string& name) const {
+  const auto it = std::find(gridNames_.begin(), gridNames_.end(), name);
+  if (it != gridNames_.end()) {
+    const uint32_t index = uint32_t(it - gridNames_.begin());
+    for (uint32_t b = 0; b < bodies_.size(); ++b)
+      if (bodies_.shape[b].isGrid() && bodies_.shape[b].grid == index) return b;
+  }
+  throw SceneError(scene_.source + ": no grid body named '" + name + "'");
 }
 
 const Terrain& World::terrain(uint32_t index) const {

@@ -118,6 +118,9 @@ class World {
   uint32_t gridCount() const { return uint32_t(grids_.size()); }
   /// Grid `index` (< gridCount(), else InvalidInput), shared by every body that is a copy of it.
   const BrickGrid& grid(uint32_t index) const;
+  /// The body of the scene's grid named `name` (the first body using it); SceneError when no
+  /// grid has that name.
+  uint32_t gridBody(const std::string& name) const;
   /// Terrains in scene order, and terrain `index` (< terrainCount(), else InvalidInput).
   uint32_t terrainCount() const { return uint32_t(terrains_.size()); }
   const Terrain& terrain(uint32_t index) const;

@@ -29,6 +29,8 @@
 /// | ring_station | ~100k bricks   | 0.01 .. 64      |
 /// | plate_stack  | 300 plates     | 0.01 .. 64      |
 /// | city_block   | ~2M bricks     | 0.001 .. 8      |
+/// | chain_link   | ~350 bricks    | 0.1 .. 64 (scales lengths, not the count) |
+/// | hangar       | ~1.5k bricks   | 0.25 .. 16      |
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -128,11 +130,42 @@ GeneratedBuild generatePlateStackBricks(uint64_t seed, float scale);
 /// Throws InvalidInput naming `scale` unless 0.001 <= scale <= 8.
 GeneratedBuild generateCityBlock(uint64_t seed, float scale);
 
+/// Dimensions of a chain link (generateChainLink) at a scale.
+struct LinkDimensions {
+  float cell = 0.f;        ///< edge of the cells the wire is made of (its bricks are runs of them)
+  float wireRadius = 0.f;  ///< radius of the wire (the link's bar)
+  float arcRadius = 0.f;   ///< radius of the centre line's end arcs
+  float straight = 0.f;    ///< length of the centre line's straight sides (along Z)
+  Aabb hole;               ///< a box inside the link's hole that no brick reaches into
+};
+LinkDimensions chainLinkDimensions(float scale);
+
+/// A chain link of microbricks in the grid's XZ plane, long along Z and centred on the origin:
+/// a wire of radius 0.24 x scale around a stadium centre line (straight sides 0.96 x scale
+/// long, end arcs of radius 0.72 x scale), each run of wire cells along Z one brick (~350
+/// bricks at every scale: scale multiplies every length). Another link fits through its hole
+/// (interiors[0], chainLinkDimensions(scale).hole): links `chainLinkDimensions(scale)` apart
+/// interlock without touching when each is turned a quarter about Z from the last and their
+/// centres are less than the hole's length minus twice the wire apart. The seed is unused (a
+/// link has one shape). No lights.
+/// Throws InvalidInput naming `scale` unless 0.1 <= scale <= 64.
+GeneratedBuild generateChainLink(uint64_t seed, float scale);
+
+/// A docking hangar: a slot open at x = 0 and closed at its back (x = length), 96 x 16 x 24
+/// inside at scale 1 (each grown with sqrt(scale)), its floor's top at z = 0: a floor and roof
+/// of 3.2 x 3.2 x 0.8 plates, side walls of 3.2 x 0.8 x 1.6 panels in running bond with seeded
+/// glass panels, a back wall, and a frame of beams around the outside every 8 units (the first
+/// one rims the mouth). interiors[0] is the slot. Its convex hull closes the mouth: a ship
+/// flying in meets the hangar's bricks only with two-way grid pairs.
+/// Lights: one under the roof every 8 units along the slot (12 at scale 1).
+/// Throws InvalidInput naming `scale` unless 0.25 <= scale <= 16.
+GeneratedBuild generateHangar(uint64_t seed, float scale);
+
 /// Names accepted by generateBuild, in a fixed order.
 std::vector<std::string> buildNames();
 
 /// Dispatches by name ("house", "truck", "carrier", "ring_station", "plate_stack",
-/// "city_block"); throws InvalidInput listing the valid names for any other.
+/// "city_block", "chain_link", "hangar"); throws InvalidInput listing the valid names for any other.
 GeneratedBuild generateBuild(const std::string& name, uint64_t seed, float scale);
 
 }  // namespace bw

@@ -17,6 +17,7 @@
 #include "cli/series.h"
 #include "cli/output_check.h"
 #include "world/bullet_baseline.h"
+#include "world/scene_checks.h"
 #include "world/scene_file.h"
 #include "world/world.h"
 
@@ -57,6 +58,32 @@ nlohmann::json insideSolidList(const ContainmentReport& inside, const std::vecto
   return list;
 }
 
+// The scene's own checks (scene_checks.h) as JSON: links kept, grids where they should end.
+nlohmann::json checksJson(const SceneCheckTracker& checks) {
+  const LinkCheckReport& l = checks.links();
+  nlohmann::json j{{"pass", checks.pass()}};
+  if (l.pairs)
+    j["linked"] = {{"pairs", l.pairs}, {"parted_at_end", l.partedNow}, {"ever_parted", l.everParted},
+                   {"first_parted_frame", l.firstPartedFrame}, {"first_parted", l.firstParted}};
+  for (const EndsInReport& e : checks.endsIn())
+    j["ends_in"].push_back({{"grid", e.grid}, {"inside", e.inside}, {"position", {e.position.x(), e.position.y(), e.position.z()}}});
+  return j;
+}
+
+void printChecks(const SceneCheckTracker& checks) {
+  if (!checks.any()) return;
+  const LinkCheckReport& l = checks.links();
+  if (l.pairs) {
+    std::printf("  check linked: %u of %u neighbouring grids ever parted", l.everParted, l.pairs);
+    if (l.everParted) std::printf(" (first %s at frame %u), %u apart at the end", l.firstParted.c_str(), l.firstPartedFrame, l.partedNow);
+    std::printf("\n");
+  }
+  for (const EndsInReport& e : checks.endsIn())
+    std::printf("  check ends_in: %s %s its box, at (%.2f, %.2f, %.2f)\n", e.grid.c_str(), e.inside ? "ended in" : "did NOT end in",
+                e.position.x(), e.position.y(), e.position.z());
+  std::printf("  scene checks: %s\n", checks.pass() ? "pass" : "FAIL");
+}
+
 // The same scene in Bullet from a fresh World's initial state (bullet_baseline.h). The fresh
 // World is also the judge of Bullet's accuracy: it is moved to Bullet's poses after every frame
 // and its containment tracker counts Bullet's bodies inside solid as it counts ours (except
@@ -70,6 +97,7 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
   World judge(judged, threads);
   BulletBaseline bullet(judge, setup, chunkSize, kinematic);
   ContainmentTracker containment(judge);
+  SceneCheckTracker checks(judge);
   std::vector<Vec3d> positions;
   std::vector<Quatf> rotations;
   Series total;
@@ -106,6 +134,7 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
     bullet.poses(positions, rotations);
     judge.setPoses(positions, rotations);
     containment.update();
+    checks.update();
     if (!json && frames >= 100 && (f + 1) % (frames / 10) == 0)
       std::fprintf(stderr, "  %s frame %u/%u  %.2f ms\n", label, f + 1, frames, total.v.back());
   }
@@ -143,6 +172,7 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
                    {"bricks_edited", bricksEdited}, {"parts_made", bullet.partsMade()}};
   }
   if (inside.count()) out["inside_solid"] = insideSolidList(inside, positions);
+  if (checks.any()) out["checks"] = checksJson(checks);
   if (rays) {
     out["rays_per_frame"] = double(rays) / frames;
     out["ray_hit_share"] = double(rayHits) / double(rays);
@@ -161,6 +191,7 @@ double runBullet(const SceneDescription& scene, int threads, BulletSetup setup, 
                 std::isfinite(lowest) ? lowest : 0.0);
     std::printf("  bodies inside solid at the end: %u; deepest contact %.1f mm over the run, %.1f mm in the last frame\n",
                 inside.count(), deepest * 1e3, endDeepest * 1e3);
+    printChecks(checks);
   }
   return total.quantile(0.5);
 }
@@ -231,6 +262,7 @@ int runScene(const SceneRunOptions& o) {
   float deepest = 0, endDeepest = 0;  // deepest contact over the run and in the last frame
   std::vector<Vec3d> settled;  // positions at --drift-after
   ContainmentTracker containment(world);  // updated after each step, outside its timing
+  SceneCheckTracker checks(world);        // the scene's own checks, likewise
   RenderFigures render;
   const auto tRun = Clock::now();
   double simulationMs = 0;  // the steps' own time; the rest of the run is bookkeeping
@@ -242,6 +274,7 @@ int runScene(const SceneRunOptions& o) {
     const StepStats& s = world.lastStats();
     simulationMs += s.totalMs;
     containment.update();
+    checks.update();
     endDeepest = deepestContact(world);
     deepest = std::max(deepest, endDeepest);
     total.v.push_back(s.totalMs);
@@ -347,6 +380,7 @@ int runScene(const SceneRunOptions& o) {
                      {"bookkeeping_ms", bookkeepingMs},
                      {"bookkeeping_share", bookkeepingMs / std::max(simulationMs, 1e-9)}};
     if (inside.count()) j["inside_solid"] = insideSolidList(inside, bodies.position);
+    if (checks.any()) j["checks"] = checksJson(checks);
     if (!settled.empty()) j["drift_after_frame"] = {{"frame", o.driftAfter}, {"max_displacement_m", drift}};
     if (!scene.terrains.empty()) {
       j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
@@ -388,7 +422,7 @@ int runScene(const SceneRunOptions& o) {
       j[key + "_over_brickworld_median"] = bulletMedian / std::max(total.quantile(0.5), 1e-9);
     }
     std::cout << j.dump(2) << "\n";
-    return modesAgree ? 0 : 3;
+    return !modesAgree ? 3 : checks.pass() ? 0 : 4;
   }
   std::printf("scene %s (%s): %u bodies, %llu bricks, built in %.0f ms; %u frames on %d thread(s) in %.2f s\n", scene.name.c_str(),
               path.c_str(), world.bodies().size(), (unsigned long long)world.brickCount(), buildMs, frames, o.threads, runS);
@@ -432,6 +466,7 @@ int runScene(const SceneRunOptions& o) {
     const Vec3d& p = bodies.position[inside.bodies[k]];
     std::printf("    body %u at (%.2f, %.2f, %.2f): %s\n", inside.bodies[k], p.x(), p.y(), p.z(), insideSolidName(inside.reasons[k]));
   }
+  printChecks(checks);
   if (!settled.empty())
     std::printf("  drift: largest displacement of a dynamic body from frame %u to the end %.3f mm\n", o.driftAfter, drift * 1e3);
   if (world.render()) render.print(world);
@@ -450,7 +485,7 @@ int runScene(const SceneRunOptions& o) {
     std::printf("%s / brickworld median frame time: %.1fx\n", setup == BulletSetup::Expert ? "bullet" : "bullet-naive",
                 bulletMedian / std::max(total.quantile(0.5), 1e-9));
   }
-  return modesAgree ? 0 : 3;
+  return !modesAgree ? 3 : checks.pass() ? 0 : 4;
 }
 
 }  // namespace bw::cli

@@ -106,6 +106,15 @@ TEST(SceneFile, BadValuesNameTheFileTheFieldAndTheExpectation) {
       {R"({"name": "x", "rays": {"count": -1}, "grids": [{"name": "g", "generator": "house"}]})", "scene.rays.count: expected an integer"},
       {R"({"name": "x", "rays": {"count": 10, "direction": 1}, "grids": [{"name": "g", "generator": "house"}]})",
        "scene.rays.direction: unknown field"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house"}], "checks": {"linked": [["g", "h"]]}})",
+       "scene.checks.linked[0][1]: expected the name of a grid declared in \"grids\", got \"h\""},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house"}], "checks": {"linked": [["g"]]}})",
+       "scene.checks.linked[0]: expected an array of at least 2 grid names"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house"}, {"name": "h", "generator": "truck"}], "checks": {"linked": [["g", "h", "g"]]}})",
+       "scene.checks.linked[0][2]: expected a grid not already in this chain"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house"}], "checks": {"ends_in": [{"grid": "g", "min": [0, 0, 1], "max": [1, 1, 0]}]}})",
+       "scene.checks.ends_in[0]: min.z is greater than max.z"},
+      {R"({"name": "x", "grids": [{"name": "g", "generator": "house"}], "checks": {"reach": 1}})", "scene.checks.reach: unknown field"},
   };
   for (const BadCase& c : cases) {
     try {

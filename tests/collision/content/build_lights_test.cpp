@@ -34,6 +34,7 @@ struct LightCase {
 constexpr LightCase kCases[] = {
     {"house", 0.25f, 4.f},       {"truck", 0.25f, 4.f},  {"carrier", 0.04f, 0.64f},
     {"ring_station", 0.04f, 0.64f}, {"plate_stack", 0.1f, 1.f}, {"city_block", 0.01f, 0.04f},
+    {"chain_link", 0.25f, 4.f},  {"hangar", 0.25f, 4.f},
 };
 
 // Every light finite with a radius of 4 to 15, inside the bounds grown by 0.5, and outside every
@@ -67,14 +68,14 @@ TEST(BuildLights, InsideTheBoundsAndNeverInsideABrick) {
   }
 }
 
-// Lights where promised (none for the plate stack), and more of them for larger builds: fixed
+// Lights where promised (none for the plate stack and the chain link), and more of them for larger builds: fixed
 // for the truck, more for the others over a 16x (city: 4x) scale step, never more than the
 // scale step itself (the brick count's growth).
 TEST(BuildLights, CountsScaleSensibly) {
   for (const LightCase& c : kCases) {
     const size_t small = generateBuild(c.name, 3, c.small).lights.size();
     const size_t large = generateBuild(c.name, 3, c.large).lights.size();
-    if (std::string(c.name) == "plate_stack") {
+    if (std::string(c.name) == "plate_stack" || std::string(c.name) == "chain_link") {
       EXPECT_EQ(small, 0u);
       EXPECT_EQ(large, 0u);
       continue;
@@ -96,6 +97,7 @@ TEST(BuildLights, CountsScaleSensibly) {
   EXPECT_EQ(generateRingStation(3, 1.f).lights.size(), 44u);
   EXPECT_EQ(generatePlateStackBricks(3, 1.f).lights.size(), 0u);
   EXPECT_EQ(generateCityBlock(3, 0.05f).lights.size(), 61u);
+  EXPECT_EQ(generateHangar(3, 1.f).lights.size(), 12u);
 }
 
 TEST(BuildLights, KindsWherePromised) {
