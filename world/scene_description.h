@@ -194,7 +194,6 @@ struct SceneChecks {
     Vec3d min = Vec3d::Zero(), max = Vec3d::Zero();  ///< world box
   };
   std::vector<EndsIn> endsIn;
-  bool empty() const { return linked.empty() && endsIn.empty(); }
 };
 
 struct SceneDescription {

@@ -29,7 +29,7 @@
 /// | ring_station | ~100k bricks   | 0.01 .. 64      |
 /// | plate_stack  | 300 plates     | 0.01 .. 64      |
 /// | city_block   | ~2M bricks     | 0.001 .. 8      |
-/// | chain_link   | ~350 bricks    | 0.1 .. 64 (scales lengths, not the count) |
+/// | chain_link   | 216 bricks     | 0.1 .. 64 (scales lengths, not the count) |
 /// | hangar       | ~1.5k bricks   | 0.25 .. 16      |
 #include <cstdint>
 #include <string>
@@ -142,12 +142,12 @@ LinkDimensions chainLinkDimensions(float scale);
 
 /// A chain link of microbricks in the grid's XZ plane, long along Z and centred on the origin:
 /// a wire of radius 0.24 x scale around a stadium centre line (straight sides 0.96 x scale
-/// long, end arcs of radius 0.72 x scale), each run of wire cells along Z one brick (~350
-/// bricks at every scale: scale multiplies every length). Another link fits through its hole
-/// (interiors[0], chainLinkDimensions(scale).hole): links `chainLinkDimensions(scale)` apart
-/// interlock without touching when each is turned a quarter about Z from the last and their
-/// centres are less than the hole's length minus twice the wire apart. The seed is unused (a
-/// link has one shape). No lights.
+/// long, end arcs of radius 0.72 x scale) of 0.08 x scale cells, each run of cells along Z one
+/// brick (216 bricks at every scale: scale multiplies every length). Another link fits through
+/// its hole (interiors[0], chainLinkDimensions(scale).hole): two links turned a quarter about Z
+/// from each other, their centres on the Z axis less than the hole's inner length (straight +
+/// 2 (arcRadius - wireRadius)) apart, interlock without touching. The seed is unused (a link
+/// has one shape). No lights.
 /// Throws InvalidInput naming `scale` unless 0.1 <= scale <= 64.
 GeneratedBuild generateChainLink(uint64_t seed, float scale);
 

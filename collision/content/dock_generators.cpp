@@ -30,8 +30,8 @@ GeneratedBuild generateChainLink(uint64_t /*seed: a link has one shape*/, float 
   };
   return runBuild("chain_link", [&](BuildWriter& w) {
     w.part("link");
-    // Runs of solid cells along Z become one brick each: ~350 bricks (a long run on each
-    // straight side, short ones where the wire bends across Z).
+    // Runs of solid cells along Z become one brick each: 216 bricks (long runs on the straight
+    // sides, short ones where the wire bends across Z).
     for (int j = -ny; j < ny; ++j)
       for (int i = -nx; i < nx; ++i)
         for (int k = -nz; k < nz;) {
