@@ -164,36 +164,47 @@ struct DeepestCounter : btCollisionWorld::ContactResultCallback {
   }
 };
 
+// The rival as its experts set it up: the city as static 8 m chunk compounds in a world with an
+// optimised dbvt broadphase; the truck one compound of its bricks' exact shapes (its dynamic
+// AABB tree on, optimised as the chunks' trees are), children relative to the truck's frame.
+struct BulletCityAndTruck {
+  BulletBrickShapes shapes;
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher{&config};
+  btDbvtBroadphase broadphase;
+  btCollisionWorld world{&dispatcher, &broadphase, &config};
+  std::vector<BulletBrickChunk> chunks;
+  std::vector<std::unique_ptr<btCollisionObject>> objects;
+  btCompoundShape truck;
+  btCollisionObject query;
+
+  explicit BulletCityAndTruck(const Scene& s) : truck(true, int(s.truck->brickCount())) {
+    chunks = buildBulletChunks(*s.city, 8.f, shapes);
+    for (const BulletBrickChunk& c : chunks) {
+      auto o = std::make_unique<btCollisionObject>();
+      o->setCollisionShape(c.shape.get());
+      o->setWorldTransform(btTransform(btQuaternion::getIdentity(), btVector3(c.origin.x(), c.origin.y(), c.origin.z())));
+      o->setCollisionFlags(o->getCollisionFlags() | btCollisionObject::CF_STATIC_OBJECT);
+      world.addCollisionObject(o.get(), int(btBroadphaseProxy::StaticFilter),
+                               int(btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter));
+      objects.push_back(std::move(o));
+    }
+    broadphase.optimize();
+    s.truck->forEachBrick([&](uint32_t id) {
+      const Brick& b = s.truck->brick(id);
+      truck.addChildShape(BulletBrickShapes::childTransform(b, Vec3f::Zero()), shapes.shapeFor(b));
+    });
+    truck.getDynamicAabbTree()->optimizeTopDown();  // as the chunks' trees (buildBulletChunks)
+    query.setCollisionShape(&truck);
+  }
+};
+
 void GridVsGrid_btCompound(benchmark::State& state) {
   Scene& s = scene();
-  BulletBrickShapes shapes;
-  // The city: 8 m chunk compounds, static, in a world with an optimised dbvt broadphase.
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher(&config);
-  btDbvtBroadphase broadphase;
-  btCollisionWorld world(&dispatcher, &broadphase, &config);
-  std::vector<BulletBrickChunk> chunks = buildBulletChunks(*s.city, 8.f, shapes);
-  std::vector<std::unique_ptr<btCollisionObject>> objects;
-  for (const BulletBrickChunk& c : chunks) {
-    auto o = std::make_unique<btCollisionObject>();
-    o->setCollisionShape(c.shape.get());
-    o->setWorldTransform(btTransform(btQuaternion::getIdentity(), btVector3(c.origin.x(), c.origin.y(), c.origin.z())));
-    o->setCollisionFlags(o->getCollisionFlags() | btCollisionObject::CF_STATIC_OBJECT);
-    world.addCollisionObject(o.get(), int(btBroadphaseProxy::StaticFilter), int(btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter));
-    objects.push_back(std::move(o));
-  }
-  broadphase.optimize();
-  // The truck: one compound of its bricks' exact shapes (its dynamic AABB tree on), children
-  // relative to the truck's frame.
-  btCompoundShape truck(true, int(s.truck->brickCount()));
-  s.truck->forEachBrick([&](uint32_t id) {
-    const Brick& b = s.truck->brick(id);
-    truck.addChildShape(BulletBrickShapes::childTransform(b, Vec3f::Zero()), shapes.shapeFor(b));
-  });
-  truck.createAabbTreeFromChildren();
-  truck.getDynamicAabbTree()->optimizeTopDown();  // as the chunks' trees (buildBulletChunks)
-  btCollisionObject query;
-  query.setCollisionShape(&truck);
+  BulletCityAndTruck bt(s);
+  btCollisionWorld& world = bt.world;
+  btCollisionObject& query = bt.query;
+  const std::vector<BulletBrickChunk>& chunks = bt.chunks;
   DeepestCounter cb;
   uint64_t q = 0;
   for (auto _ : state) {
@@ -220,30 +231,10 @@ void GridVsGrid_btCompound(benchmark::State& state) {
 // them per contactTest. Contacts are the manifolds' points.
 void GridVsGrid_btCompoundPersistent(benchmark::State& state) {
   Scene& s = scene();
-  BulletBrickShapes shapes;
-  btDefaultCollisionConfiguration config;
-  btCollisionDispatcher dispatcher(&config);
-  btDbvtBroadphase broadphase;
-  btCollisionWorld world(&dispatcher, &broadphase, &config);
-  std::vector<BulletBrickChunk> chunks = buildBulletChunks(*s.city, 8.f, shapes);
-  std::vector<std::unique_ptr<btCollisionObject>> objects;
-  for (const BulletBrickChunk& c : chunks) {
-    auto o = std::make_unique<btCollisionObject>();
-    o->setCollisionShape(c.shape.get());
-    o->setWorldTransform(btTransform(btQuaternion::getIdentity(), btVector3(c.origin.x(), c.origin.y(), c.origin.z())));
-    o->setCollisionFlags(o->getCollisionFlags() | btCollisionObject::CF_STATIC_OBJECT);
-    world.addCollisionObject(o.get(), int(btBroadphaseProxy::StaticFilter), int(btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter));
-    objects.push_back(std::move(o));
-  }
-  broadphase.optimize();
-  btCompoundShape truck(true, int(s.truck->brickCount()));
-  s.truck->forEachBrick([&](uint32_t id) {
-    const Brick& b = s.truck->brick(id);
-    truck.addChildShape(BulletBrickShapes::childTransform(b, Vec3f::Zero()), shapes.shapeFor(b));
-  });
-  truck.getDynamicAabbTree()->optimizeTopDown();
-  btCollisionObject query;
-  query.setCollisionShape(&truck);
+  BulletCityAndTruck bt(s);
+  btCollisionWorld& world = bt.world;
+  btCollisionDispatcher& dispatcher = bt.dispatcher;
+  btCollisionObject& query = bt.query;
   query.setCollisionFlags(query.getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
   world.addCollisionObject(&query, int(btBroadphaseProxy::DefaultFilter), int(btBroadphaseProxy::AllFilter));
   auto manifoldPoints = [&](float* deepest) {
