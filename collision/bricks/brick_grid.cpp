@@ -154,7 +154,7 @@ GridRayHit BrickGrid::raycast(const Ray& ray, uint32_t mask, QueryStats* stats) 
   // brick's frame) round differently, so by one ulp the index could reject a brick the ray only
   // grazes, or whose exact entry ties the best hit. Traversing bounds grown by a few ulps of the
   // largest coordinate involved keeps the index conservative: every brick rayBrick hits within
-  // maxT is tested, so the result is rayBrick's smallest t, ties going to the lowest handle.
+  // maxT is tested, so the result is rayBrick's smallest t (of bricks tied there, the first met).
   const RayHit h = index_.sweepClosest(ray, Vec3f::Constant(roundingMargin(ray.origin)), mask,
                                        [&](uint32_t e, float, float tMax, float& tHit) {
                                          Vec3f n;

@@ -29,8 +29,9 @@ void collectPoints(const BrickGrid& grid, uint32_t c, int s, int level, int dept
     const int n = brickVertices(grid.brick(tree.payload(e)), v);
     pts.insert(pts.end(), v, v + n);
   });
-  if (cl.child[s] != kInvalidIndex)
-    for (int o = 0; o < 8; ++o) collectPoints(grid, cl.child[s], o, level + 1, depth, pts);
+  cl.forEachSubCluster(s, [&](uint32_t sub) {
+    for (int o = 0; o < 8; ++o) collectPoints(grid, sub, o, level + 1, depth, pts);
+  });
 }
 
 }  // namespace
@@ -58,8 +59,10 @@ void BrickGrid::coverBoxes(uint32_t maxBoxes, std::vector<Aabb>& out) const {
       }
       grew = true;
       index_.forEachHeldPublic(cl, n.slot, [&](uint32_t) { ++heldHere; });
-      for (int o = 0; o < 8; ++o)
-        if (!index_.cluster(cl.child[n.slot]).isEmpty(o)) next.push_back({cl.child[n.slot], o});
+      cl.forEachSubCluster(n.slot, [&](uint32_t sub) {
+        for (int o = 0; o < 8; ++o)
+          if (!index_.cluster(sub).isEmpty(o)) next.push_back({sub, o});
+      });
     }
     if (!grew || next.size() + held.size() + heldHere > maxBoxes) break;
     for (const Node& n : frontier) {

@@ -35,11 +35,11 @@ void open(const Side& side, const Item& it, const Item& other, std::vector<std::
     }
   };
   side.tree.forEachHeldPublic(cl, s, [&](uint32_t e) { push(Item{e, kBrick}); });
-  if (cl.child[s] == kInvalidIndex) return;
-  const uint32_t c = cl.child[s];
-  const octobvh::NodeCluster& ch = side.tree.cluster(c);
-  for (int o = 0; o < 8; ++o)
-    if (!ch.isEmpty(o)) push(Item{octobvh::nodeRef(c, o), kNode});
+  cl.forEachSubCluster(s, [&](uint32_t c) {
+    const octobvh::NodeCluster& ch = side.tree.cluster(c);
+    for (int o = 0; o < 8; ++o)
+      if (!ch.isEmpty(o)) push(Item{octobvh::nodeRef(c, o), kNode});
+  });
 }
 
 }  // namespace

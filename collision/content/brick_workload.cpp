@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
+#include "collision/core/errors.h"
 #include "collision/core/seeded_random.h"
 
 namespace bw {
@@ -23,6 +25,8 @@ Vec3f smallSize(SeededRandom& r, bool micro) {
 }  // namespace
 
 std::vector<Aabb> generateBrickWorkload(const BrickWorkloadParams& p) {
+  if (!(p.density > 0.f) || !std::isfinite(p.density))
+    throw InvalidInput("generateBrickWorkload: density is " + std::to_string(p.density) + ", expected a finite value > 0");
   SeededRandom r(p.seed);
   struct Cluster {
     Vec3d centre;
@@ -67,9 +71,9 @@ std::vector<Aabb> generateBrickWorkload(const BrickWorkloadParams& p) {
     clusters[ci].volume += double(size.prod());
   }
   // Real bricks tile space instead of piling up: each cluster gets the radius at which its bricks
-  // fill 10..60% of its volume (hollow hulls next to solid detail).
+  // fill 10..60% of its volume (hollow hulls next to solid detail), times the density.
   for (auto& c : clusters) {
-    const double fill = r.logUniform(0.1, 0.6);
+    const double fill = r.logUniform(0.1, 0.6) * double(p.density);
     c.radius = std::max(2.0, std::cbrt(c.volume / fill * 3.0 / (4.0 * 3.14159265358979)));
   }
   // Pass 2: positions, normally spread around the cluster centre (sigma = radius / 2).

@@ -112,7 +112,14 @@ void OctoBvh::reserveHeadroom(const char* context) const {
 
 uint32_t OctoBvh::heldCount(uint32_t c, int s) const {
   const NodeCluster& cl = clusters_[c];
+  if (cl.numHeld[s] == kForcedCluster) return 0;
   return cl.numHeld[s] == kOverflow ? overflow_[cl.leaf[s]].count : cl.numHeld[s];
+}
+
+uint32_t OctoBvh::subtreeCount(uint32_t c, int s) const {
+  uint32_t n = heldCount(c, s);
+  clusters_[c].forEachSubCluster(s, [&](uint32_t sub) { n += clusters_[sub].childTotal; });
+  return n;
 }
 
 void OctoBvh::heldAdd(uint32_t c, int s, uint32_t e) {
@@ -216,6 +223,7 @@ void OctoBvh::heldRemove(uint32_t c, int s, uint32_t e) {
 
 void OctoBvh::heldTake(uint32_t c, int s, std::vector<uint32_t>& out) {
   NodeCluster& cl = clusters_[c];
+  BW_ASSERT(cl.numHeld[s] != kForcedCluster);
   forEachHeld(cl, s, [&](uint32_t e) { out.push_back(e); });
   if (cl.numHeld[s] == kOverflow) {
     for (uint32_t b = cl.leaf[s]; b != kInvalidIndex;) {
@@ -253,15 +261,15 @@ bool OctoBvh::refit(uint32_t c, int s) {
     filter |= r.filter;
     mml = std::max(mml, minLevelOf(r));
   });
-  if (cl.child[s] != kInvalidIndex) {
-    const NodeCluster& ch = clusters_[cl.child[s]];
+  cl.forEachSubCluster(s, [&](uint32_t sub) {
+    const NodeCluster& ch = clusters_[sub];
     for (int o = 0; o < 8; ++o) {
       if (ch.isEmpty(o)) continue;
       b.merge(ch.bounds(o));
       filter |= ch.filter[o];
       mml = std::max<int>(mml, ch.maxMinLevel[o]);
     }
-  }
+  });
   const bool changed = !(cl.bounds(s) == b) || cl.filter[s] != filter || cl.maxMinLevel[s] != mml;
   cl.setBounds(s, b);
   cl.filter[s] = filter;
@@ -277,29 +285,27 @@ void OctoBvh::makeLeaf(uint32_t c, int s, const uint32_t* elems, uint32_t count)
 void OctoBvh::gatherSubtree(uint32_t cluster, int s, std::vector<uint32_t>& out) const {
   const NodeCluster& cl = clusters_[cluster];
   forEachHeld(cl, s, [&](uint32_t e) { out.push_back(e); });
-  if (cl.child[s] != kInvalidIndex)
+  cl.forEachSubCluster(s, [&](uint32_t sub) {
     for (int o = 0; o < 8; ++o)
-      if (!clusters_[cl.child[s]].isEmpty(o)) gatherSubtree(cl.child[s], o, out);
+      if (!clusters_[sub].isEmpty(o)) gatherSubtree(sub, o, out);
+  });
 }
 
 void OctoBvh::freeSubtreeClusters(uint32_t cluster) {
   std::vector<uint32_t> dropped;
   for (int o = 0; o < 8; ++o) {
+    NodeCluster& cl = clusters_[cluster];
+    if (cl.numHeld[o] == kForcedCluster) {
+      const uint32_t forced = cl.leaf[o];
+      cl.numHeld[o] = 0;
+      cl.leaf[o] = kInvalidIndex;
+      freeSubtreeClusters(forced);
+    }
     if (clusters_[cluster].child[o] != kInvalidIndex) freeSubtreeClusters(clusters_[cluster].child[o]);
     dropped.clear();
     heldTake(cluster, o, dropped);
   }
   clusters_.free(cluster);
-}
-
-void OctoBvh::collectBig(uint32_t cluster, int s, int level, std::vector<uint32_t>& out) const {
-  const NodeCluster& cl = clusters_[cluster];
-  if (cl.maxMinLevel[s] < level) return;  // nothing that large below: skip the subtree
-  forEachHeld(cl, s, [&](uint32_t e) {
-    if (minLevelOf(elements_[e]) >= level) out.push_back(e);
-  });
-  if (cl.child[s] != kInvalidIndex)
-    for (int o = 0; o < 8; ++o) collectBig(cl.child[s], o, level, out);
 }
 
 // ---------------------------------------------------------------- canonical build
@@ -313,24 +319,37 @@ void OctoBvh::build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32
   uint32_t* mid = std::partition(elems, elems + count, [&](uint32_t e) { return minLevelOf(elements_[e]) >= cube.level; });
   const uint32_t big = uint32_t(mid - elems);
   const bool forced = big > uint32_t(kLeafCapacity);
-  const uint32_t held = forced ? 0 : big;
-
   const uint32_t child = allocCluster(cube.level - 1);
   clusters_[c].child[s] = child;
-  clusters_[child].childTotal = count - held;
-  clusters_[child].forcedCount = forced ? big : 0;
-  for (uint32_t i = 0; i < held; ++i) heldAdd(c, s, elems[i]);
+  if (!forced) {
+    for (uint32_t i = 0; i < big; ++i) heldAdd(c, s, elems[i]);
+    buildOctants(child, cube, elems + big, count - big);
+  } else if (big == count) {
+    // Nothing fits a child: the large elements are forced into the children.
+    clusters_[child].forcedCount = big;
+    buildOctants(child, cube, elems, count);
+  } else {
+    const uint32_t forcedCluster = allocCluster(cube.level - 1);
+    clusters_[c].leaf[s] = forcedCluster;
+    clusters_[c].numHeld[s] = kForcedCluster;
+    clusters_[forcedCluster].forcedCount = big;
+    buildOctants(forcedCluster, cube, elems, big);
+    buildOctants(child, cube, elems + big, count - big);
+  }
+  refit(c, s);
+}
 
-  // 8-way partition of the rest by the child cube holding each centre.
-  uint32_t* down = elems + held;
-  const uint32_t n = count - held;
+// 8-way partition of elems by the child cube of `cube` holding each centre, each part built
+// into its node of cluster `sub`.
+void OctoBvh::buildOctants(uint32_t sub, const Cube& cube, uint32_t* elems, uint32_t n) {
+  clusters_[sub].childTotal = n;
   uint32_t counts[8] = {};
   auto slotOf = [&](uint32_t e) {
     double ctr[3];
     centreOf(elements_[e], ctr);
     return cube.childSlotFor(ctr);
   };
-  for (uint32_t i = 0; i < n; ++i) ++counts[slotOf(down[i])];
+  for (uint32_t i = 0; i < n; ++i) ++counts[slotOf(elems[i])];
   uint32_t start[8], next[8];
   for (int o = 0, acc = 0; o < 8; ++o) {
     start[o] = next[o] = uint32_t(acc);
@@ -339,14 +358,13 @@ void OctoBvh::build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32
   for (int o = 0; o < 8; ++o) {
     const uint32_t end = start[o] + counts[o];
     while (next[o] < end) {
-      const int t = slotOf(down[next[o]]);
+      const int t = slotOf(elems[next[o]]);
       if (t == o) ++next[o];
-      else std::swap(down[next[o]], down[next[t]++]);
+      else std::swap(elems[next[o]], elems[next[t]++]);
     }
   }
   for (int o = 0; o < 8; ++o)
-    if (counts[o]) build(child, o, cube.child(o), down + start[o], counts[o]);
-  refit(c, s);
+    if (counts[o]) build(sub, o, cube.child(o), elems + start[o], counts[o]);
 }
 
 int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {

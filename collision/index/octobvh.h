@@ -14,7 +14,12 @@
 ///   and every min level; below it every node is a lattice cube [k 2^L, (k+1) 2^L).
 /// - A node whose subtree holds <= 8 elements is a leaf holding them all. Otherwise elements
 ///   that fit a child (min level < L) go to the child holding their centre and the rest stay;
-///   if more than 8 would stay, all of them are forced into the children by centre.
+///   if more than 8 would stay, all of them are forced down by centre: into the children when
+///   nothing fits a child, else into a second cluster of 8 octant nodes, the node's forced
+///   cluster, beside its children. Giants forced down among small bricks would stretch the
+///   small bricks' tight bounds to their own size, so every query near a giant would walk the
+///   small bricks' subtrees (the dense build of issue 20: 3x the box tests); apart, the
+///   children's bounds stay tight and a forced cluster holds only giants.
 /// - Recursion stops at level kMinLevel, where a leaf may hold more than 8.
 /// Inserts and removes re-evaluate these rules only along the path they touch; tight bounds,
 /// filter ORs and counts are kept up to date incrementally.
@@ -52,6 +57,7 @@ class OctoBvh {
     uint64_t leaves = 0;             ///< non-empty nodes without children
     uint64_t innerNodes = 0;         ///< nodes with children
     uint64_t forcedNodes = 0;        ///< inner nodes that force-split
+    uint64_t forcedClusters = 0;     ///< of those, nodes whose forced elements sit in a forced cluster
     uint64_t forcedElements = 0;     ///< elements sitting below their min level
   };
 
@@ -118,6 +124,8 @@ class OctoBvh {
                   QueryStats* stats = nullptr) const;
 
   /// Closest hit along the ray within [0, ray.maxT]; exact(handle, tEnterBox, tMax, tHit).
+  /// Of several hits at the same t, the first the traversal meets (the same one for the same tree
+  /// state): nodes entered at the best t are not opened to look for a lower handle.
   template <class Exact = AabbRayExact>
   RayHit raycastClosest(const Ray& ray, uint32_t mask, QueryStats* stats = nullptr, Exact&& exact = {},
                         RayChildOrder order = RayChildOrder::FrontToBack) const;
@@ -175,11 +183,12 @@ class OctoBvh {
 
   void insertAt(uint32_t c, int s, const Cube& cube, uint32_t e);
   bool removeAt(uint32_t c, int s, const Cube& cube, uint32_t e);
-  void passToChild(uint32_t c, int s, const Cube& cube, uint32_t e);
-  bool removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e);
+  void passDown(uint32_t sub, const Cube& cube, uint32_t e);
+  bool removeBelow(uint32_t sub, const Cube& cube, uint32_t e);
+  void mergeIntoLeaf(uint32_t c, int s, uint32_t removed);
   void build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32_t count);
+  void buildOctants(uint32_t sub, const Cube& cube, uint32_t* elems, uint32_t count);
   void makeLeaf(uint32_t c, int s, const uint32_t* elems, uint32_t count);
-  void collectBig(uint32_t c, int s, int level, std::vector<uint32_t>& out) const;
   void gatherSubtree(uint32_t c, int s, std::vector<uint32_t>& out) const;
   void freeSubtreeClusters(uint32_t cluster);
   bool refit(uint32_t c, int s);
@@ -188,6 +197,8 @@ class OctoBvh {
 
   // held-element lists (leaf blocks, or overflow chains at kMinLevel)
   uint32_t heldCount(uint32_t c, int s) const;
+  /// Elements in the node's subtree: held, in its children and in its forced cluster.
+  uint32_t subtreeCount(uint32_t c, int s) const;
   void heldAdd(uint32_t c, int s, uint32_t e);
   void heldRemove(uint32_t c, int s, uint32_t e);
   void heldTake(uint32_t c, int s, std::vector<uint32_t>& out);

@@ -34,11 +34,11 @@ uint64_t OctoBvh::hashNode(uint32_t c, int s) const {
   forEachHeld(cl, s, [&](uint32_t e) { keys.push_back(elementKey(elements_[e])); });
   std::sort(keys.begin(), keys.end());  // order inside a leaf is not part of the structure
   for (uint64_t k : keys) h = hashCombine(h, k);
-  if (cl.child[s] != kInvalidIndex) {
-    const NodeCluster& ch = clusters_[cl.child[s]];
-    h = hashCombine(hashCombine(hashCombine(h, 0xC1D5ull), ch.childTotal), ch.forcedCount);
-    for (int o = 0; o < 8; ++o) h = hashCombine(h, hashNode(cl.child[s], o));
-  }
+  cl.forEachSubCluster(s, [&](uint32_t sub) {
+    const NodeCluster& ch = clusters_[sub];
+    h = hashCombine(hashCombine(hashCombine(h, sub == cl.child[s] ? 0xC1D5ull : 0xF0CEull), ch.childTotal), ch.forcedCount);
+    for (int o = 0; o < 8; ++o) h = hashCombine(h, hashNode(sub, o));
+  });
   return h;
 }
 
@@ -58,7 +58,8 @@ void OctoBvh::validateNode(uint32_t c, int s, const Cube& cube, std::vector<uint
   forEachHeld(cl, s, [&](uint32_t e) { held.push_back(e); });
   if (cl.numHeld[s] == kOverflow && (cube.level != kMinLevel || held.size() <= size_t(kLeafCapacity)))
     broken(where.str() + ": overflow chain above the minimum level or with <= 8 elements");
-  if (cl.numHeld[s] != kOverflow && cl.numHeld[s] > kLeafCapacity) broken(where.str() + ": more than 8 held");
+  if (cl.numHeld[s] != kOverflow && cl.numHeld[s] != kForcedCluster && cl.numHeld[s] > kLeafCapacity)
+    broken(where.str() + ": more than 8 held");
   const double width = std::ldexp(1.0, cube.level);
   for (uint32_t e : held) {
     if (!elements_.isLive(e)) broken(where.str() + ": holds a dead element " + std::to_string(e));
@@ -69,25 +70,44 @@ void OctoBvh::validateNode(uint32_t c, int s, const Cube& cube, std::vector<uint
         broken(where.str() + ": element " + std::to_string(e) + " centre outside the node cube");
     out.push_back(e);
   }
+  const uint32_t forced = cl.forced(s);
   if (cl.child[s] == kInvalidIndex) {
+    if (forced != kInvalidIndex) broken(where.str() + ": a forced cluster without children");
     if (held.size() > size_t(kLeafCapacity) && cube.level != kMinLevel) broken(where.str() + ": leaf with > 8 above min level");
   } else {
+    // Validates the 8 nodes of cluster `sub` and returns how many elements they hold.
+    auto validateSub = [&](uint32_t sub) {
+      const size_t before = out.size();
+      for (int o = 0; o < 8; ++o) validateNode(sub, o, cube.child(o), out);
+      const size_t below = out.size() - before;
+      if (below != clusters_[sub].childTotal)
+        broken(where.str() + ": childTotal " + std::to_string(clusters_[sub].childTotal) + " but " + std::to_string(below) + " below");
+      return below;
+    };
     const NodeCluster& ch = clusters_[cl.child[s]];
-    const size_t beforeChildren = out.size();
-    for (int o = 0; o < 8; ++o) validateNode(cl.child[s], o, cube.child(o), out);
-    const size_t inChildren = out.size() - beforeChildren;
-    if (inChildren != ch.childTotal)
-      broken(where.str() + ": childTotal " + std::to_string(ch.childTotal) + " but " + std::to_string(inChildren) + " below");
+    const size_t inChildren = validateSub(cl.child[s]);
+    size_t inForced = 0;
+    if (forced != kInvalidIndex) {
+      const size_t beforeForced = out.size();
+      inForced = validateSub(forced);
+      if (clusters_[forced].forcedCount != inForced) broken(where.str() + ": forced cluster's forcedCount is stale");
+      for (size_t i = beforeForced; i < out.size(); ++i)
+        if (minLevelOf(elements_[out[i]]) < cube.level) broken(where.str() + ": forced cluster holds an element that fits a child");
+    }
     const size_t n = out.size() - first;
     if (n <= size_t(kLeafCapacity)) broken(where.str() + ": inner node with only " + std::to_string(n) + " elements");
     size_t big = 0;
     for (size_t i = first; i < out.size(); ++i) big += minLevelOf(elements_[out[i]]) >= cube.level;
-    if (big > size_t(kLeafCapacity)) {
-      if (ch.forcedCount != big || !held.empty())
-        broken(where.str() + ": should force-split " + std::to_string(big) + " elements, forcedCount " +
+    if (big > size_t(kLeafCapacity) && big == n) {
+      if (ch.forcedCount != big || forced != kInvalidIndex || !held.empty())
+        broken(where.str() + ": should force all " + std::to_string(big) + " elements into its children, forcedCount " +
                std::to_string(ch.forcedCount) + ", held " + std::to_string(held.size()));
+    } else if (big > size_t(kLeafCapacity)) {
+      if (forced == kInvalidIndex || inForced != big || ch.forcedCount != 0)
+        broken(where.str() + ": should force " + std::to_string(big) + " elements into a forced cluster beside " +
+               std::to_string(inChildren) + " in its children");
     } else {
-      if (ch.forcedCount != 0) broken(where.str() + ": forcedCount set without a forced split");
+      if (ch.forcedCount != 0 || forced != kInvalidIndex) broken(where.str() + ": forced without a forced split");
       if (held.size() != big) broken(where.str() + ": holds " + std::to_string(held.size()) + " but " + std::to_string(big) + " are too large for the children");
       for (uint32_t e : held)
         if (minLevelOf(elements_[e]) < cube.level) broken(where.str() + ": holds an element that fits a child");
@@ -142,8 +162,11 @@ void OctoBvh::shapeNode(uint32_t c, int s, int depth, ShapeStats& st) const {
     ++st.leaves;
   } else {
     ++st.innerNodes;
-    if (clusters_[cl.child[s]].forcedCount) ++st.forcedNodes;
-    for (int o = 0; o < 8; ++o) shapeNode(cl.child[s], o, depth + 1, st);
+    if (clusters_[cl.child[s]].forcedCount || cl.forced(s) != kInvalidIndex) ++st.forcedNodes;
+    if (cl.forced(s) != kInvalidIndex) ++st.forcedClusters;
+    cl.forEachSubCluster(s, [&](uint32_t sub) {
+      for (int o = 0; o < 8; ++o) shapeNode(sub, o, depth + 1, st);
+    });
   }
   forEachHeld(cl, s, [&](uint32_t e) { st.forcedElements += minLevelOf(elements_[e]) > cl.level; });
 }

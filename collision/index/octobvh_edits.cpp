@@ -72,7 +72,7 @@ void OctoBvh::growRootToHold(const double c[3], int minLevel) {
           dc.numHeld[t] = old.numHeld[o];
           dc.filter[t] = old.filter[o];
           dc.maxMinLevel[t] = old.maxMinLevel[o];
-          dc.childTotal = heldCount(oldC, o) + clusters_[old.child[o]].childTotal;
+          dc.childTotal = subtreeCount(oldC, o);
           nc.setBounds(o, old.bounds(o));
           nc.child[o] = d;
           nc.filter[o] = old.filter[o];
@@ -88,13 +88,16 @@ void OctoBvh::growRootToHold(const double c[3], int minLevel) {
   }
 }
 
-void OctoBvh::passToChild(uint32_t c, int s, const Cube& cube, uint32_t e) {
-  const uint32_t child = clusters_[c].child[s];
-  ++clusters_[child].childTotal;
+// Passes e down into the node of cluster `sub` (the children or the forced cluster of the node
+// whose cube is `cube`) holding its centre.
+void OctoBvh::passDown(uint32_t sub, const Cube& cube, uint32_t e) {
+  NodeCluster& to = clusters_[sub];
+  ++to.childTotal;
+  if (to.forcedCount) ++to.forcedCount;
   double ctr[3];
   centreOf(elements_[e], ctr);
   const int o = cube.childSlotFor(ctr);
-  insertAt(child, o, cube.child(o), e);
+  insertAt(sub, o, cube.child(o), e);
 }
 
 void OctoBvh::insertAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
@@ -122,27 +125,43 @@ void OctoBvh::insertAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
     build(c, s, cube, nine.data(), uint32_t(nine.size()));
     return;
   }
-  NodeCluster& ch = clusters_[cl.child[s]];
-  if (m >= cube.level) {
-    if (ch.forcedCount > 0) {
-      ++ch.forcedCount;
-      passToChild(c, s, cube, e);
-      return;
+  const uint32_t child = cl.child[s];
+  if (m < cube.level) {
+    if (clusters_[child].forcedCount > 0) {
+      // The first element to fit a child under a node that forced everything it had: the forced
+      // subtree moves whole to the node's forced cluster, and new children take this element.
+      const uint32_t natural = allocCluster(cube.level - 1);
+      NodeCluster& n = clusters_[c];
+      n.leaf[s] = child;
+      n.numHeld[s] = kForcedCluster;
+      n.child[s] = natural;
     }
-    if (cl.numHeld[s] < kLeafCapacity) {
-      heldAdd(c, s, e);
-      return;
-    }
-    // A 9th element too large for the children: force-split all of them by centre.
-    std::vector<uint32_t> big;
-    big.reserve(9);
-    heldTake(c, s, big);
-    big.push_back(e);
-    ch.forcedCount = uint32_t(big.size());
-    for (uint32_t x : big) passToChild(c, s, cube, x);
+    passDown(clusters_[c].child[s], cube, e);
     return;
   }
-  passToChild(c, s, cube, e);
+  if (cl.numHeld[s] == kForcedCluster) {
+    passDown(cl.leaf[s], cube, e);
+    return;
+  }
+  if (clusters_[child].forcedCount > 0) {
+    passDown(child, cube, e);
+    return;
+  }
+  if (cl.numHeld[s] < kLeafCapacity) {
+    heldAdd(c, s, e);
+    return;
+  }
+  // A 9th element too large for the children (some element fits them: the node is inner with
+  // only 8 held): the nine go to a new forced cluster by centre.
+  std::vector<uint32_t> big;
+  big.reserve(9);
+  heldTake(c, s, big);
+  big.push_back(e);
+  const uint32_t forced = allocCluster(cube.level - 1);
+  clusters_[c].leaf[s] = forced;
+  clusters_[c].numHeld[s] = kForcedCluster;
+  for (uint32_t x : big) passDown(forced, cube, x);  // counts childTotal only while forcedCount is 0
+  clusters_[forced].forcedCount = uint32_t(big.size());
 }
 
 // ---------------------------------------------------------------- remove
@@ -174,13 +193,35 @@ void OctoBvh::update(uint32_t handle, const Aabb& bounds, uint32_t filter) {
   insertAt(rootCluster_, 0, rootCube(), handle);
 }
 
-bool OctoBvh::removeFromChild(uint32_t c, int s, const Cube& cube, uint32_t e) {
-  const uint32_t child = clusters_[c].child[s];
-  --clusters_[child].childTotal;
+bool OctoBvh::removeBelow(uint32_t sub, const Cube& cube, uint32_t e) {
+  NodeCluster& from = clusters_[sub];
+  --from.childTotal;
+  if (from.forcedCount) --from.forcedCount;
   double ctr[3];
   centreOf(elements_[e], ctr);
   const int o = cube.childSlotFor(ctr);
-  return removeAt(child, o, cube.child(o), e);
+  return removeAt(sub, o, cube.child(o), e);
+}
+
+// The node becomes one leaf holding what is left of its subtree once `removed` is gone.
+void OctoBvh::mergeIntoLeaf(uint32_t c, int s, uint32_t removed) {
+  std::vector<uint32_t> rest;
+  rest.reserve(9);
+  gatherSubtree(c, s, rest);
+  rest.erase(std::find(rest.begin(), rest.end(), removed));
+  NodeCluster& cl = clusters_[c];
+  const uint32_t child = cl.child[s], forced = cl.forced(s);
+  cl.child[s] = kInvalidIndex;
+  if (forced != kInvalidIndex) {
+    cl.numHeld[s] = 0;
+    cl.leaf[s] = kInvalidIndex;
+    freeSubtreeClusters(forced);
+  } else {
+    std::vector<uint32_t> held;
+    heldTake(c, s, held);
+  }
+  freeSubtreeClusters(child);
+  for (uint32_t x : rest) heldAdd(c, s, x);
 }
 
 // Returns whether the node's summary (bounds, filter OR, max min level) changed, so callers
@@ -191,43 +232,44 @@ bool OctoBvh::removeAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
     heldRemove(c, s, e);
     return refit(c, s);
   }
-  const uint32_t child = cl.child[s];
-  NodeCluster& ch = clusters_[child];
-  const uint32_t after = heldCount(c, s) + ch.childTotal - 1;
-  if (after <= uint32_t(kLeafCapacity)) {
-    // Merge back: the node becomes one leaf holding what is left of its subtree.
-    std::vector<uint32_t> rest;
-    rest.reserve(9);
-    heldTake(c, s, rest);
-    for (int o = 0; o < 8; ++o)
-      if (!ch.isEmpty(o)) gatherSubtree(child, o, rest);
-    rest.erase(std::find(rest.begin(), rest.end(), e));
-    freeSubtreeClusters(child);
-    clusters_[c].child[s] = kInvalidIndex;
-    for (uint32_t x : rest) heldAdd(c, s, x);
+  if (subtreeCount(c, s) - 1 <= uint32_t(kLeafCapacity)) {
+    mergeIntoLeaf(c, s, e);
     return refit(c, s);
   }
+  const uint32_t child = cl.child[s];
+  const uint32_t forced = cl.forced(s);
   const int m = minLevelOf(elements_[e]);
   bool below = true;  // whether something below may have changed this node's summary
-  if (m >= cube.level) {
-    if (ch.forcedCount > uint32_t(kLeafCapacity) + 1) {
-      --ch.forcedCount;
-      below = removeFromChild(c, s, cube, e);
-    } else if (ch.forcedCount > 0) {
-      // Down to 8 large elements: undo the forced split. maxMinLevel leads straight to them.
-      ch.forcedCount = 0;
-      removeFromChild(c, s, cube, e);
+  if (m < cube.level) {
+    below = removeBelow(child, cube, e);
+    if (forced != kInvalidIndex && clusters_[child].childTotal == 0) {
+      // Nothing left that fits a child: the forced subtree becomes the children again.
+      clusters_.free(child);
+      NodeCluster& n = clusters_[c];
+      n.child[s] = forced;
+      n.numHeld[s] = 0;
+      n.leaf[s] = kInvalidIndex;
+      below = true;
+    }
+  } else if (forced != kInvalidIndex) {
+    below = removeBelow(forced, cube, e);
+    if (clusters_[forced].childTotal == uint32_t(kLeafCapacity)) {
+      // Down to 8 large elements: they are held here again.
       std::vector<uint32_t> big;
       big.reserve(8);
       for (int o = 0; o < 8; ++o)
-        if (!clusters_[child].isEmpty(o)) collectBig(child, o, cube.level, big);
-      for (uint32_t x : big) removeFromChild(c, s, cube, x);
+        if (!clusters_[forced].isEmpty(o)) gatherSubtree(forced, o, big);
+      NodeCluster& n = clusters_[c];
+      n.numHeld[s] = 0;
+      n.leaf[s] = kInvalidIndex;
+      freeSubtreeClusters(forced);
       for (uint32_t x : big) heldAdd(c, s, x);
-    } else {
-      heldRemove(c, s, e);
+      below = true;
     }
+  } else if (clusters_[child].forcedCount > 0) {
+    below = removeBelow(child, cube, e);  // stays forced: more than 8 are left (else merged above)
   } else {
-    below = removeFromChild(c, s, cube, e);
+    heldRemove(c, s, e);
   }
   return below ? refit(c, s) : false;
 }

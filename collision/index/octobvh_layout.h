@@ -16,6 +16,7 @@ constexpr int kMinLevel = -10;          ///< smallest cube: width 2^-10 (leaves 
 constexpr int kMaxLevel = 31;           ///< largest root cube: [-2^30, 2^30)^3
 constexpr float kMaxCoordinate = 1073741824.f;  ///< |coordinate| limit (2^30)
 constexpr uint8_t kOverflow = 255;      ///< numHeld value of a min-level leaf with > 8 elements
+constexpr uint8_t kForcedCluster = 254; ///< numHeld value of a node whose leaf field is its forced cluster
 
 /// Eight sibling nodes: the children of one node. 40 bytes per node.
 struct alignas(64) NodeCluster {
@@ -23,17 +24,29 @@ struct alignas(64) NodeCluster {
   float maxX[8], maxY[8], maxZ[8];  // 192
   uint32_t child[8];                // 224  cluster holding the node's 8 children, or kInvalidIndex (leaf/empty)
   uint32_t leaf[8];                 // 256  elements held at the node: the element itself when one,
-                                    //      a LeafBlock (2..8), an OverflowBlock chain, or kInvalidIndex
+                                    //      a LeafBlock (2..8), an OverflowBlock chain, or kInvalidIndex;
+                                    //      or (numHeld kForcedCluster) the node's forced cluster
   uint32_t filter[8];               // 288  OR of filter bits of every element in the subtree
-  uint8_t numHeld[8];               // 296  elements held at the node; kOverflow: overflow chain
-  int8_t maxMinLevel[8];            // 304  largest min level in the subtree (finds forced elements)
+  uint8_t numHeld[8];               // 296  elements held at the node; kOverflow: overflow chain;
+                                    //      kForcedCluster: none held, leaf[] is the forced cluster
+  int8_t maxMinLevel[8];            // 304  largest min level in the subtree
   uint32_t childTotal;              // 308  elements in the 8 nodes' subtrees together
-  uint32_t forcedCount;             // 312  when the parent force-split: its elements with min level
-                                    //      >= the parent's level (all pushed down here); else 0
+  uint32_t forcedCount;             // 312  elements forced into these nodes: childTotal in a forced
+                                    //      cluster and in the children of a node that forced
+                                    //      everything it had (nothing fit a child); else 0
   int8_t level;                     // 313  level of these 8 nodes: each is a cube of width 2^level
   uint8_t pad[7];                   // 320
 
   bool isEmpty(int s) const { return numHeld[s] == 0 && child[s] == kInvalidIndex; }
+  /// The node's forced cluster (its too-large elements, apart from its children), or kInvalidIndex.
+  uint32_t forced(int s) const { return numHeld[s] == kForcedCluster ? leaf[s] : kInvalidIndex; }
+  /// f(cluster) for the node's child cluster and its forced cluster, when it has them.
+  template <class F>
+  void forEachSubCluster(int s, F&& f) const {
+    if (child[s] == kInvalidIndex) return;
+    f(child[s]);
+    if (numHeld[s] == kForcedCluster) f(leaf[s]);
+  }
   Aabb bounds(int s) const { return {{minX[s], minY[s], minZ[s]}, {maxX[s], maxY[s], maxZ[s]}}; }
   void setBounds(int s, const Aabb& b) {
     minX[s] = b.min.x(); minY[s] = b.min.y(); minZ[s] = b.min.z();

@@ -7,8 +7,9 @@
 namespace bw {
 
 namespace octobvh_detail {
-/// Depth-first stack bound: <= 7 pending siblings per level over kMaxLevel - kMinLevel + 2 levels.
-constexpr int kStackSize = 7 * (octobvh::kMaxLevel - octobvh::kMinLevel + 2) + 16;
+/// Depth-first stack bound: <= 15 pending nodes per level (a node's children and forced cluster)
+/// over kMaxLevel - kMinLevel + 2 levels.
+constexpr int kStackSize = 15 * (octobvh::kMaxLevel - octobvh::kMinLevel + 2) + 16;
 struct RayEntry {
   uint32_t node;  // cluster << 3 | slot
   float t;        // entry parameter of the node's tight bounds
@@ -24,7 +25,7 @@ void OctoBvh::forEachHeld(const NodeCluster& cl, int s, F&& f) const {
       for (uint32_t i = 0; i < 14 && left; ++i, --left) f(overflow_[b].elements[i]);
   } else if (cl.numHeld[s] == 1) {
     f(cl.leaf[s]);  // a single element is stored inline
-  } else if (cl.numHeld[s]) {
+  } else if (cl.numHeld[s] && cl.numHeld[s] != kForcedCluster) {
     const LeafBlock& lb = leaves_[cl.leaf[s]];
     for (int i = 0; i < cl.numHeld[s]; ++i) f(lb.elements[i]);
   }
@@ -78,16 +79,16 @@ void OctoBvh::walkOverlap(const Aabb& outer, uint32_t mask, QueryStats* stats, O
         ++elementTests;
         onElement(e, r);
       });
-      if (cl.child[s] == kInvalidIndex) continue;
-      const uint32_t c = cl.child[s];
-      unsigned candidates;
-      unsigned hits = overlapMask(clusters_[c], outer, mask, candidates);
-      tests += unsigned(std::popcount(candidates));
-      while (hits) {
-        const int o = std::countr_zero(hits);
-        hits &= hits - 1;
-        if (accept(c, o)) stack[sp++] = nodeRef(c, o);
-      }
+      cl.forEachSubCluster(s, [&](uint32_t c) {
+        unsigned candidates;
+        unsigned hits = overlapMask(clusters_[c], outer, mask, candidates);
+        tests += unsigned(std::popcount(candidates));
+        while (hits) {
+          const int o = std::countr_zero(hits);
+          hits &= hits - 1;
+          if (accept(c, o)) stack[sp++] = nodeRef(c, o);
+        }
+      });
     }
   }
   if (stats) {
@@ -135,8 +136,7 @@ void OctoBvh::overlapLod(const Aabb& box, uint32_t mask, float lodFraction, F&& 
         if (!(cl.maxX[o] - cl.minX[o] < threshold && cl.maxY[o] - cl.minY[o] < threshold &&
               cl.maxZ[o] - cl.minZ[o] < threshold))
           return true;
-        const uint32_t n = heldCount(c, o) + (cl.child[o] != kInvalidIndex ? clusters_[cl.child[o]].childTotal : 0u);
-        onLod(LodBox{cl.bounds(o), cl.filter[o], n});
+        onLod(LodBox{cl.bounds(o), cl.filter[o], subtreeCount(c, o)});
         return false;
       });
 }
@@ -164,12 +164,14 @@ inline std::array<uint8_t, 8> OctoBvh::rayChildOrder(const Vec3f& dir) {
 namespace octobvh_detail {
 /// Shared ray traversal: calls onElement(e, tEnterBox) for elements whose bounds the ray enters
 /// before the current limit; onElement returns the new limit (pruning farther nodes) and may
-/// set `stop` to end the traversal.
+/// set `stop` to end the traversal. Once `tiesPruned` is set, nodes and elements entered exactly
+/// at the limit are skipped too: a closest-hit search keeps the first hit it meets at a given t
+/// (a ray that starts inside bricks has every node around its origin at t = 0).
 /// `grow` expands every node and element box before the ray test: a sweep of a shape whose
 /// bounds have half extents `grow` is a ray against the grown boxes (article 000, "Sweep Query").
 template <class Tree, class OnElement>
 void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::array<uint8_t, 8>& order, float& limit,
-                 bool& stop, uint64_t& tests, uint64_t& elementTests, OnElement&& onElement,
+                 bool& stop, const bool& tiesPruned, uint64_t& tests, uint64_t& elementTests, OnElement&& onElement,
                  const Vec3f& grow = Vec3f::Zero()) {
   using namespace octobvh;
   const uint32_t rootC = tree.rootCluster();
@@ -183,7 +185,7 @@ void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::arr
   stack[sp++] = {nodeRef(rootC, 0), t};
   while (sp && !stop) {
     const RayEntry top = stack[--sp];
-    if (top.t > limit) continue;  // a closer hit was found after this node was pushed
+    if (top.t > limit || (tiesPruned && top.t == limit)) continue;  // a hit this close was found since
     const NodeCluster& cl = tree.cluster(top.node >> 3);
     const int s = int(top.node & 7);
     tree.forEachHeldPublic(cl, s, [&](uint32_t e) {
@@ -193,19 +195,25 @@ void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::arr
       ++tests;
       ++elementTests;
       float te;
-      if (intersectRayAabb(ray, r.bounds().expanded(grow), 0.f, limit, te)) limit = onElement(e, te, stop);
+      if (intersectRayAabb(ray, r.bounds().expanded(grow), 0.f, limit, te) && !(tiesPruned && te == limit))
+        limit = onElement(e, te, stop);
     });
+    // The forced cluster first, then the children, each pushed far-to-near: the nearest child is
+    // popped first.
+    auto push = [&](uint32_t c) {
+      const NodeCluster& ch = tree.cluster(c);
+      for (int k = 7; k >= 0; --k) {
+        const int o = order[k];
+        if (!(ch.filter[o] & mask)) continue;
+        ++tests;
+        float tc;
+        if (intersectRayAabb(ray, ch.bounds(o).expanded(grow), 0.f, limit, tc) && !(tiesPruned && tc == limit))
+          stack[sp++] = {nodeRef(c, o), tc};
+      }
+    };
     if (cl.child[s] == kInvalidIndex) continue;
-    const uint32_t c = cl.child[s];
-    const NodeCluster& ch = tree.cluster(c);
-    // Push far-to-near so the nearest child is popped first.
-    for (int k = 7; k >= 0; --k) {
-      const int o = order[k];
-      if (!(ch.filter[o] & mask)) continue;
-      ++tests;
-      float tc;
-      if (intersectRayAabb(ray, ch.bounds(o).expanded(grow), 0.f, limit, tc)) stack[sp++] = {nodeRef(c, o), tc};
-    }
+    if (cl.forced(s) != kInvalidIndex) push(cl.forced(s));
+    push(cl.child[s]);
   }
 }
 }  // namespace octobvh_detail
@@ -217,14 +225,15 @@ RayHit OctoBvh::raycastClosest(const Ray& ray, uint32_t mask, QueryStats* stats,
   if (orderKind == RayChildOrder::Reversed) std::reverse(order.begin(), order.end());
   RayHit best{RayHit().element, ray.maxT};
   float limit = ray.maxT;
-  bool stop = false;
+  bool stop = false, found = false;
   uint64_t tests = 0, elementTests = 0;
-  octobvh_detail::traverseRay(*this, ray, mask, order, limit, stop, tests, elementTests,
+  octobvh_detail::traverseRay(*this, ray, mask, order, limit, stop, found, tests, elementTests,
                               [&](uint32_t e, float tBox, bool&) {
                                 float th;
-                                if (exact(e, tBox, limit, th) && th <= limit &&
-                                    (th < best.t || (th == best.t && e < best.element)))
+                                if (exact(e, tBox, limit, th) && th <= limit && (!found || th < best.t)) {
                                   best = {e, th};
+                                  found = true;
+                                }
                                 return best.hit() ? best.t : limit;
                               });
   if (stats) {
@@ -239,13 +248,16 @@ RayHit OctoBvh::sweepClosest(const Ray& ray, const Vec3f& halfExtents, uint32_t 
                              QueryStats* stats) const {
   RayHit best{RayHit().element, ray.maxT};
   float limit = ray.maxT;
-  bool stop = false;
+  bool stop = false, found = false;
   uint64_t tests = 0, elementTests = 0;
   octobvh_detail::traverseRay(
-      *this, ray, mask, rayChildOrder(ray.dir), limit, stop, tests, elementTests,
+      *this, ray, mask, rayChildOrder(ray.dir), limit, stop, found, tests, elementTests,
       [&](uint32_t e, float tBox, bool&) {
         float th;
-        if (exact(e, tBox, limit, th) && th <= limit && (th < best.t || (th == best.t && e < best.element))) best = {e, th};
+        if (exact(e, tBox, limit, th) && th <= limit && (!found || th < best.t)) {
+          best = {e, th};
+          found = true;
+        }
         return best.hit() ? best.t : limit;
       },
       halfExtents);
@@ -256,13 +268,17 @@ RayHit OctoBvh::sweepClosest(const Ray& ray, const Vec3f& halfExtents, uint32_t 
   return best;
 }
 
+namespace octobvh_detail {
+inline constexpr bool kNoTiePruning = false;  // every-hit and any-hit searches keep every t
+}  // namespace octobvh_detail
+
 template <class Exact>
 RayHit OctoBvh::raycastAny(const Ray& ray, uint32_t mask, QueryStats* stats, Exact&& exact) const {
   RayHit found;
   float limit = ray.maxT;
   bool stop = false;
   uint64_t tests = 0, elementTests = 0;
-  octobvh_detail::traverseRay(*this, ray, mask, rayChildOrder(ray.dir), limit, stop, tests, elementTests,
+  octobvh_detail::traverseRay(*this, ray, mask, rayChildOrder(ray.dir), limit, stop, octobvh_detail::kNoTiePruning, tests, elementTests,
                               [&](uint32_t e, float tBox, bool& halt) {
                                 float th;
                                 if (exact(e, tBox, limit, th) && th <= limit) {
@@ -285,7 +301,7 @@ void OctoBvh::raycastAll(const Ray& ray, uint32_t mask, std::vector<RayHit>& out
   float limit = ray.maxT;
   bool stop = false;
   uint64_t tests = 0, elementTests = 0;
-  octobvh_detail::traverseRay(*this, ray, mask, rayChildOrder(ray.dir), limit, stop, tests, elementTests,
+  octobvh_detail::traverseRay(*this, ray, mask, rayChildOrder(ray.dir), limit, stop, octobvh_detail::kNoTiePruning, tests, elementTests,
                               [&](uint32_t e, float tBox, bool&) {
                                 float th;
                                 if (exact(e, tBox, limit, th) && th <= limit) out.push_back({e, th});

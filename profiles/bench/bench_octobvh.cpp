@@ -53,19 +53,25 @@ std::map<std::string, double>& summary() {
   return s;
 }
 
-const std::vector<Aabb>& build(uint32_t n) {
-  static std::map<uint32_t, std::vector<Aabb>> cache;
-  auto it = cache.find(n);
+// The seeded build of n bricks: sparse (density 1) or dense (bw::kDenseBuild: the same bricks
+// packed 200x tighter, ~75 elements in a 2 m box around a brick, a third of them huge).
+const std::vector<Aabb>& build(uint32_t n, bool dense = false) {
+  static std::map<std::pair<uint32_t, bool>, std::vector<Aabb>> cache;
+  auto it = cache.find({n, dense});
   if (it == cache.end()) {
     bw::BrickWorkloadParams p;
     p.count = n;
     p.seed = 2024;
     p.clusters = 30;
     p.extent = n >= 1'000'000 ? 4000.f : 2000.f;
-    it = cache.emplace(n, bw::generateBrickWorkload(p)).first;
+    p.density = dense ? bw::kDenseBuild : 1.f;
+    it = cache.emplace(std::pair(n, dense), bw::generateBrickWorkload(p)).first;
   }
   return it->second;
 }
+
+// Summary key suffix of a build.
+std::string buildKey(bool dense) { return dense ? "_dense" : ""; }
 
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -286,21 +292,22 @@ void loadDbvtOptimized(benchmark::State& state, std::span<const Aabb> bricks, co
   }
 }
 
+// Load rows take (bricks, dense 0/1).
+std::string loadKey(const benchmark::State& state) {
+  return std::to_string(state.range(0)) + (state.range(1) ? "_dense" : "");
+}
 template <class Index>
 void loadWith(benchmark::State& state, const char* name) {
-  const uint32_t n = uint32_t(state.range(0));
-  loadIndex<Index>(state, build(n), name, std::to_string(n));
+  loadIndex<Index>(state, build(uint32_t(state.range(0)), state.range(1) != 0), name, loadKey(state));
 }
 
 void Load_OctoBVH(benchmark::State& state) { loadWith<bw::OctoBvh>(state, "OctoBVH"); }
 void Load_LooseOctree(benchmark::State& state) { loadWith<bw::LooseOctree>(state, "LooseOctree"); }
 void Load_btDbvt(benchmark::State& state) {
-  const uint32_t n = uint32_t(state.range(0));
-  loadDbvt(state, build(n), std::to_string(n));
+  loadDbvt(state, build(uint32_t(state.range(0)), state.range(1) != 0), loadKey(state));
 }
 void Load_btDbvtOptimized(benchmark::State& state) {
-  const uint32_t n = uint32_t(state.range(0));
-  loadDbvtOptimized(state, build(n), std::to_string(n));
+  loadDbvtOptimized(state, build(uint32_t(state.range(0)), state.range(1) != 0), loadKey(state));
 }
 
 struct btDbvtOptimizedTag {};  // selects loadDbvtOptimized in loadLighthouse
@@ -337,11 +344,12 @@ void LoadLighthouseTiled_btDbvtOptimized(benchmark::State& s) { loadLighthouse<b
 constexpr uint32_t kMillion = 1'000'000;
 
 template <class Index>
-Index& prebuilt() {
-  static std::unique_ptr<Index> index;
+Index& prebuilt(bool dense) {
+  static std::unique_ptr<Index> built[2];
+  auto& index = built[dense ? 1 : 0];
   if (!index) {
     index = std::make_unique<Index>(typename Index::Config{kMillion + 100'000});
-    const auto& b = build(kMillion);
+    const auto& b = build(kMillion, dense);
     for (uint32_t i = 0; i < kMillion; ++i) index->insert(b[i], 1, i);
   }
   return *index;
@@ -355,12 +363,12 @@ struct DbvtBuild {
 // The 1M tree as incremental inserts leave it (naive) or, as a separate copy built by the same
 // inserts, after optimizeTopDown() (what a user calls after a bulk build). Separate trees, so
 // Edit_btDbvt's edits never reach the optimized one and the order of the rows does not matter.
-DbvtBuild& prebuiltDbvt(bool optimized = false) {
-  static std::unique_ptr<DbvtBuild> d[2];
-  auto& p = d[optimized ? 1 : 0];
+DbvtBuild& prebuiltDbvt(bool optimized, bool dense) {
+  static std::unique_ptr<DbvtBuild> d[2][2];
+  auto& p = d[optimized ? 1 : 0][dense ? 1 : 0];
   if (!p) {
     p = std::make_unique<DbvtBuild>();
-    const auto& b = build(kMillion);
+    const auto& b = build(kMillion, dense);
     for (uint32_t i = 0; i < kMillion; ++i) p->leaves.push_back(p->tree.insert(volume(b[i]), nullptr));
     if (optimized) {
       const auto t = Clock::now();
@@ -372,8 +380,8 @@ DbvtBuild& prebuiltDbvt(bool optimized = false) {
 }
 
 // Queries centred on random existing bricks so they land where the geometry is.
-std::vector<Vec3f> queryCentres(uint32_t count, uint64_t seed) {
-  const auto& b = build(kMillion);
+std::vector<Vec3f> queryCentres(uint32_t count, uint64_t seed, bool dense) {
+  const auto& b = build(kMillion, dense);
   bw::SeededRandom r(seed);
   std::vector<Vec3f> out;
   for (uint32_t i = 0; i < count; ++i) out.push_back(b[r.below(kMillion)].center());
@@ -393,9 +401,9 @@ std::vector<Vec3f> rayDirections(uint32_t count, uint64_t seed) {
 // ---------------------------------------------------------------- edits at 1M
 
 template <class Index>
-void editsWith(benchmark::State& state, const char* name) {
-  Index& index = prebuilt<Index>();
-  const auto& b = build(kMillion);
+void editsWith(benchmark::State& state, const char* name, bool dense) {
+  Index& index = prebuilt<Index>(dense);
+  const auto& b = build(kMillion, dense);
   constexpr uint32_t kOps = 20'000;
   bw::SeededRandom r(7);
   for (auto _ : state) {
@@ -427,16 +435,16 @@ void editsWith(benchmark::State& state, const char* name) {
     state.counters["insert_ns"] = insertNs;
     state.counters["remove_ns"] = removeNs;
     state.counters["update_ns"] = updateNs;
-    summary()[std::string("insert_ns_") + name] = insertNs;
-    summary()[std::string("remove_ns_") + name] = removeNs;
+    summary()[std::string("insert_ns_") + name + buildKey(dense)] = insertNs;
+    summary()[std::string("remove_ns_") + name + buildKey(dense)] = removeNs;
   }
 }
-void Edit_OctoBVH(benchmark::State& state) { editsWith<bw::OctoBvh>(state, "OctoBVH"); }
-void Edit_LooseOctree(benchmark::State& state) { editsWith<bw::LooseOctree>(state, "LooseOctree"); }
+void Edit_OctoBVH(benchmark::State& state, bool dense) { editsWith<bw::OctoBvh>(state, "OctoBVH", dense); }
+void Edit_LooseOctree(benchmark::State& state, bool dense) { editsWith<bw::LooseOctree>(state, "LooseOctree", dense); }
 
-void Edit_btDbvt(benchmark::State& state) {
-  DbvtBuild& d = prebuiltDbvt();
-  const auto& b = build(kMillion);
+void Edit_btDbvt(benchmark::State& state, bool dense) {
+  DbvtBuild& d = prebuiltDbvt(false, dense);
+  const auto& b = build(kMillion, dense);
   constexpr uint32_t kOps = 20'000;
   bw::SeededRandom r(7);
   for (auto _ : state) {
@@ -463,17 +471,17 @@ void Edit_btDbvt(benchmark::State& state) {
     state.counters["insert_ns"] = insertNs;
     state.counters["remove_ns"] = removeNs;
     state.counters["update_ns"] = updateNs;
-    summary()["insert_ns_btDbvt"] = insertNs;
-    summary()["remove_ns_btDbvt"] = removeNs;
+    summary()["insert_ns_btDbvt" + buildKey(dense)] = insertNs;
+    summary()["remove_ns_btDbvt" + buildKey(dense)] = removeNs;
   }
 }
 
 // ---------------------------------------------------------------- overlap 2 m
 
 template <class Index>
-void overlapWith(benchmark::State& state, const char* name) {
-  const Index& index = prebuilt<Index>();
-  const auto centres = queryCentres(4096, 11);
+void overlapWith(benchmark::State& state, const char* name, bool dense) {
+  const Index& index = prebuilt<Index>(dense);
+  const auto centres = queryCentres(4096, 11, dense);
   bw::QueryStats st;
   uint64_t hits = 0, q = 0;
   const auto t0 = Clock::now();
@@ -481,16 +489,16 @@ void overlapWith(benchmark::State& state, const char* name) {
     const Aabb box = Aabb::fromCenterHalf(centres[q++ & 4095], Vec3f::Constant(1.f));
     index.overlap(box, 1, [&](uint32_t) { ++hits; }, &st);
   }
-  summary()[std::string("overlap_us_") + name] = secondsSince(t0) * 1e6 / double(state.iterations());
+  summary()[std::string("overlap_us_") + name + buildKey(dense)] = secondsSince(t0) * 1e6 / double(state.iterations());
   state.counters["box_tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
   state.counters["hits"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
-  summary()[std::string("overlap_tests_") + name] = double(st.boxTests) / double(state.iterations());
+  summary()[std::string("overlap_tests_") + name + buildKey(dense)] = double(st.boxTests) / double(state.iterations());
 }
-void Overlap2m_OctoBVH(benchmark::State& state) { overlapWith<bw::OctoBvh>(state, "OctoBVH"); }
-void Overlap2m_LooseOctree(benchmark::State& state) { overlapWith<bw::LooseOctree>(state, "LooseOctree"); }
-void overlapDbvt(benchmark::State& state, bool optimized, const std::string& name) {
-  DbvtBuild& d = prebuiltDbvt(optimized);
-  const auto centres = queryCentres(4096, 11);
+void Overlap2m_OctoBVH(benchmark::State& state, bool dense) { overlapWith<bw::OctoBvh>(state, "OctoBVH", dense); }
+void Overlap2m_LooseOctree(benchmark::State& state, bool dense) { overlapWith<bw::LooseOctree>(state, "LooseOctree", dense); }
+void overlapDbvt(benchmark::State& state, bool optimized, const std::string& name, bool dense) {
+  DbvtBuild& d = prebuiltDbvt(optimized, dense);
+  const auto centres = queryCentres(4096, 11, dense);
   CountHits hits;
   uint64_t q = 0;
   const auto t0 = Clock::now();
@@ -507,18 +515,18 @@ void overlapDbvt(benchmark::State& state, bool optimized, const std::string& nam
   state.counters["box_tests"] = double(tests) / double(centres.size());
   state.counters["max_depth"] = double(btDbvt::maxdepth(d.tree.m_root));
   if (optimized) state.counters["optimize_ms"] = d.optimizeSeconds * 1e3;
-  summary()["overlap_tests_" + name] = double(tests) / double(centres.size());
-  summary()["overlap_us_" + name] = us;
+  summary()["overlap_tests_" + name + buildKey(dense)] = double(tests) / double(centres.size());
+  summary()["overlap_us_" + name + buildKey(dense)] = us;
 }
-void Overlap2m_btDbvt(benchmark::State& state) { overlapDbvt(state, false, "btDbvt"); }
-void Overlap2m_btDbvtOptimized(benchmark::State& state) { overlapDbvt(state, true, "btDbvtOptimized"); }
+void Overlap2m_btDbvt(benchmark::State& state, bool dense) { overlapDbvt(state, false, "btDbvt", dense); }
+void Overlap2m_btDbvtOptimized(benchmark::State& state, bool dense) { overlapDbvt(state, true, "btDbvtOptimized", dense); }
 
 // ---------------------------------------------------------------- rays
 
 template <class Index>
-void rayWith(benchmark::State& state, const char* key, float length, bw::RayChildOrder order) {
-  const Index& index = prebuilt<Index>();
-  const auto origins = queryCentres(4096, 13);
+void rayWith(benchmark::State& state, const std::string& key, float length, bw::RayChildOrder order, bool dense = false) {
+  const Index& index = prebuilt<Index>(dense);
+  const auto origins = queryCentres(4096, 13, dense);
   const auto dirs = rayDirections(4096, 14);
   bw::QueryStats st;
   uint64_t hits = 0, q = 0;
@@ -529,19 +537,23 @@ void rayWith(benchmark::State& state, const char* key, float length, bw::RayChil
     const bw::Ray ray = bw::Ray::make(origins[i] + dirs[i] * 3.f, dirs[i], length);
     hits += index.raycastClosest(ray, 1, &st, bw::AabbRayExact{}, order).hit();
   }
-  summary()[std::string(key) + "_us"] = secondsSince(t0) * 1e6 / double(state.iterations());
+  summary()[key + buildKey(dense) + "_us"] = secondsSince(t0) * 1e6 / double(state.iterations());
   state.counters["box_tests"] = benchmark::Counter(double(st.boxTests), benchmark::Counter::kAvgIterations);
   state.counters["hit_rate"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
-  summary()[key] = double(st.boxTests) / double(state.iterations());
+  summary()[key + buildKey(dense)] = double(st.boxTests) / double(state.iterations());
 }
-void RayClosest200m_OctoBVH(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "ray_tests_OctoBVH", 200.f, bw::RayChildOrder::FrontToBack); }
-void RayClosest200m_LooseOctree(benchmark::State& s) { rayWith<bw::LooseOctree>(s, "ray_tests_LooseOctree", 200.f, bw::RayChildOrder::FrontToBack); }
+void RayClosest200m_OctoBVH(benchmark::State& s, bool dense) {
+  rayWith<bw::OctoBvh>(s, "ray_tests_OctoBVH", 200.f, bw::RayChildOrder::FrontToBack, dense);
+}
+void RayClosest200m_LooseOctree(benchmark::State& s, bool dense) {
+  rayWith<bw::LooseOctree>(s, "ray_tests_LooseOctree", 200.f, bw::RayChildOrder::FrontToBack, dense);
+}
 void RayOrder_OctoBVH_FrontToBack(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "order_tests_front", 2000.f, bw::RayChildOrder::FrontToBack); }
 void RayOrder_OctoBVH_Reversed(benchmark::State& s) { rayWith<bw::OctoBvh>(s, "order_tests_reversed", 2000.f, bw::RayChildOrder::Reversed); }
 
-void rayDbvt(benchmark::State& state, bool optimized, const std::string& name) {
-  DbvtBuild& d = prebuiltDbvt(optimized);
-  const auto origins = queryCentres(4096, 13);
+void rayDbvt(benchmark::State& state, bool optimized, const std::string& name, bool dense) {
+  DbvtBuild& d = prebuiltDbvt(optimized, dense);
+  const auto origins = queryCentres(4096, 13, dense);
   const auto dirs = rayDirections(4096, 14);
   auto endpoints = [&](uint64_t i) {
     const Vec3f o = origins[i] + dirs[i] * 3.f, e = o + dirs[i] * 200.f;
@@ -570,17 +582,17 @@ void rayDbvt(benchmark::State& state, bool optimized, const std::string& name) {
   state.counters["hit_rate"] = benchmark::Counter(double(hits), benchmark::Counter::kAvgIterations);
   state.counters["box_tests"] = double(tests) / 4096.0;
   if (optimized) state.counters["optimize_ms"] = d.optimizeSeconds * 1e3;
-  summary()["ray_tests_" + name] = double(tests) / 4096.0;
-  summary()["ray_tests_" + name + "_us"] = us;
+  summary()["ray_tests_" + name + buildKey(dense)] = double(tests) / 4096.0;
+  summary()["ray_tests_" + name + buildKey(dense) + "_us"] = us;
 }
-void RayClosest200m_btDbvt(benchmark::State& state) { rayDbvt(state, false, "btDbvt"); }
-void RayClosest200m_btDbvtOptimized(benchmark::State& state) { rayDbvt(state, true, "btDbvtOptimized"); }
+void RayClosest200m_btDbvt(benchmark::State& state, bool dense) { rayDbvt(state, false, "btDbvt", dense); }
+void RayClosest200m_btDbvtOptimized(benchmark::State& state, bool dense) { rayDbvt(state, true, "btDbvtOptimized", dense); }
 
 // Long rays across the whole build from outside it, aimed at a random brick (they hit).
 template <class Index>
 void longRayWith(benchmark::State& state, const char* key) {
-  const Index& index = prebuilt<Index>();
-  const auto targets = queryCentres(4096, 17);
+  const Index& index = prebuilt<Index>(false);
+  const auto targets = queryCentres(4096, 17, false);
   const auto dirs = rayDirections(4096, 18);
   bw::QueryStats st;
   uint64_t q = 0;
@@ -596,10 +608,10 @@ void LongRay_OctoBVH(benchmark::State& s) { longRayWith<bw::OctoBvh>(s, "long_te
 void LongRay_LooseOctree(benchmark::State& s) { longRayWith<bw::LooseOctree>(s, "long_tests_LooseOctree"); }
 
 // 1000 moved bricks absorbed by the index, then the same rays: no rebuild, no slowdown.
-void EditsThenRays_OctoBVH(benchmark::State& state) {
-  bw::OctoBvh& index = prebuilt<bw::OctoBvh>();
-  const auto& b = build(kMillion);
-  const auto origins = queryCentres(4096, 13);
+void EditsThenRays_OctoBVH(benchmark::State& state, bool dense) {
+  bw::OctoBvh& index = prebuilt<bw::OctoBvh>(dense);
+  const auto& b = build(kMillion, dense);
+  const auto origins = queryCentres(4096, 13, dense);
   const auto dirs = rayDirections(4096, 14);
   auto rays = [&] {
     const auto t = Clock::now();
@@ -632,7 +644,8 @@ void printSummary() {
   auto& s = summary();
   auto get = [&](const std::string& k) { return s.count(k) ? s[k] : 0.0; };
   std::printf("\n== Comparisons (same run)\n");
-  for (const std::string key : {"100000", "1000000", "4000000", "lighthouse", "lighthouse_tiled"}) {
+  for (const std::string key :
+       {"100000", "1000000", "4000000", "100000_dense", "1000000_dense", "lighthouse", "lighthouse_tiled"}) {
     if (!get("load_tests_OctoBVH_" + key) || !get("load_tests_LooseOctree_" + key)) continue;
     const double octo = get("load_tests_OctoBVH_" + key), loose = get("load_tests_LooseOctree_" + key);
     std::printf("load %-16s %8.0f bricks: box tests LooseOctree/OctoBVH = %.2fx (%.3g vs %.3g), time LooseOctree/OctoBVH = %.2fx "
@@ -665,30 +678,34 @@ void printSummary() {
                 get(otherTests) / get(octoTests), get(otherTests), get(octoTests), get(otherUs), get(octoUs),
                 t >= 1 ? t : 1 / t, t >= 1 ? "faster" : "slower");
   };
-  versus("200 m rays", "ray_tests_OctoBVH", "ray_tests_btDbvtOptimized", "ray_tests_OctoBVH_us", "ray_tests_btDbvtOptimized_us",
-         "btDbvtOptimized");
-  versus("200 m rays", "ray_tests_OctoBVH", "ray_tests_btDbvt", "ray_tests_OctoBVH_us", "ray_tests_btDbvt_us", "naive btDbvt");
-  versus("200 m rays", "ray_tests_OctoBVH", "ray_tests_LooseOctree", "ray_tests_OctoBVH_us", "ray_tests_LooseOctree_us",
-         "LooseOctree");
-  versus("2 m overlaps", "overlap_tests_OctoBVH", "overlap_tests_btDbvtOptimized", "overlap_us_OctoBVH",
-         "overlap_us_btDbvtOptimized", "btDbvtOptimized");
-  versus("2 m overlaps", "overlap_tests_OctoBVH", "overlap_tests_btDbvt", "overlap_us_OctoBVH", "overlap_us_btDbvt",
-         "naive btDbvt");
-  versus("2 m overlaps", "overlap_tests_OctoBVH", "overlap_tests_LooseOctree", "overlap_us_OctoBVH", "overlap_us_LooseOctree",
-         "LooseOctree");
-  if (get("insert_ns_OctoBVH"))
-    std::printf("edits at 1M: insert ns OctoBVH %.0f, LooseOctree %.0f, btDbvt %.0f; remove ns %.0f, %.0f, %.0f\n",
-                get("insert_ns_OctoBVH"), get("insert_ns_LooseOctree"), get("insert_ns_btDbvt"), get("remove_ns_OctoBVH"),
-                get("remove_ns_LooseOctree"), get("remove_ns_btDbvt"));
+  for (const std::string b : {"", "_dense"}) {
+    const std::string build = b.empty() ? "sparse" : "dense";
+    for (const char* rival : {"btDbvtOptimized", "btDbvt", "LooseOctree"}) {
+      const std::string label = std::string(rival) == "btDbvt" ? "naive btDbvt" : rival;
+      versus(("200 m rays, " + build).c_str(), "ray_tests_OctoBVH" + b, "ray_tests_" + std::string(rival) + b,
+             "ray_tests_OctoBVH" + b + "_us", "ray_tests_" + std::string(rival) + b + "_us", label.c_str());
+    }
+    for (const char* rival : {"btDbvtOptimized", "btDbvt", "LooseOctree"}) {
+      const std::string label = std::string(rival) == "btDbvt" ? "naive btDbvt" : rival;
+      versus(("2 m overlaps, " + build).c_str(), "overlap_tests_OctoBVH" + b, "overlap_tests_" + std::string(rival) + b,
+             "overlap_us_OctoBVH" + b, "overlap_us_" + std::string(rival) + b, label.c_str());
+    }
+    if (get("insert_ns_OctoBVH" + b))
+      std::printf("edits at 1M, %s: insert ns OctoBVH %.0f, LooseOctree %.0f, btDbvt %.0f; remove ns %.0f, %.0f, %.0f\n",
+                  build.c_str(), get("insert_ns_OctoBVH" + b), get("insert_ns_LooseOctree" + b), get("insert_ns_btDbvt" + b),
+                  get("remove_ns_OctoBVH" + b), get("remove_ns_LooseOctree" + b), get("remove_ns_btDbvt" + b));
+  }
 }
 
 }  // namespace
 
-BENCHMARK(Load_OctoBVH)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(Load_LooseOctree)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+// Load rows: (bricks, dense): the sparse build at 100k, 1M and 4M, the dense one at 100k and 1M.
+#define BW_LOAD_SIZES ->Args({100'000, 0})->Args({1'000'000, 0})->Args({100'000, 1})->Args({1'000'000, 1})
+BENCHMARK(Load_OctoBVH) BW_LOAD_SIZES->Args({4'000'000, 0})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(Load_LooseOctree) BW_LOAD_SIZES->Args({4'000'000, 0})->Iterations(1)->Unit(benchmark::kMillisecond);
 // btDbvt stops at 1M: its incremental load is superlinear here (1M took 48 s, 4M did not finish in 5 min).
-BENCHMARK(Load_btDbvt)->Arg(100'000)->Arg(1'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(Load_btDbvtOptimized)->Arg(100'000)->Arg(1'000'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(Load_btDbvt) BW_LOAD_SIZES->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(Load_btDbvtOptimized) BW_LOAD_SIZES->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_LooseOctree)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_btDbvt)->Iterations(1)->Unit(benchmark::kMillisecond);
@@ -697,22 +714,26 @@ BENCHMARK(LoadLighthouseTiled_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisec
 BENCHMARK(LoadLighthouseTiled_LooseOctree)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouseTiled_btDbvt)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouseTiled_btDbvtOptimized)->Iterations(1)->Unit(benchmark::kMillisecond);
-BENCHMARK(Edit_OctoBVH)->Iterations(3)->Unit(benchmark::kMillisecond);
-BENCHMARK(Edit_LooseOctree)->Iterations(3)->Unit(benchmark::kMillisecond);
-BENCHMARK(Edit_btDbvt)->Iterations(3)->Unit(benchmark::kMillisecond);
-BENCHMARK(Overlap2m_OctoBVH)->Unit(benchmark::kMicrosecond);
-BENCHMARK(Overlap2m_LooseOctree)->Unit(benchmark::kMicrosecond);
-BENCHMARK(Overlap2m_btDbvt)->Unit(benchmark::kMicrosecond);
-BENCHMARK(Overlap2m_btDbvtOptimized)->Unit(benchmark::kMicrosecond);
-BENCHMARK(RayClosest200m_OctoBVH)->Unit(benchmark::kMicrosecond);
-BENCHMARK(RayClosest200m_LooseOctree)->Unit(benchmark::kMicrosecond);
-BENCHMARK(RayClosest200m_btDbvt)->Unit(benchmark::kMicrosecond);
-BENCHMARK(RayClosest200m_btDbvtOptimized)->Unit(benchmark::kMicrosecond);
+// The 1M rows on the sparse and on the dense build.
+#define BW_SPARSE_DENSE(fn, ...)                    \
+  BENCHMARK_CAPTURE(fn, sparse, false)__VA_ARGS__; \
+  BENCHMARK_CAPTURE(fn, dense, true)__VA_ARGS__
+BW_SPARSE_DENSE(Edit_OctoBVH, ->Iterations(3)->Unit(benchmark::kMillisecond));
+BW_SPARSE_DENSE(Edit_LooseOctree, ->Iterations(3)->Unit(benchmark::kMillisecond));
+BW_SPARSE_DENSE(Edit_btDbvt, ->Iterations(3)->Unit(benchmark::kMillisecond));
+BW_SPARSE_DENSE(Overlap2m_OctoBVH, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(Overlap2m_LooseOctree, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(Overlap2m_btDbvt, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(Overlap2m_btDbvtOptimized, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(RayClosest200m_OctoBVH, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(RayClosest200m_LooseOctree, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(RayClosest200m_btDbvt, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(RayClosest200m_btDbvtOptimized, ->Unit(benchmark::kMicrosecond));
 BENCHMARK(RayOrder_OctoBVH_FrontToBack)->Unit(benchmark::kMicrosecond);
 BENCHMARK(RayOrder_OctoBVH_Reversed)->Unit(benchmark::kMicrosecond);
 BENCHMARK(LongRay_OctoBVH)->Unit(benchmark::kMicrosecond);
 BENCHMARK(LongRay_LooseOctree)->Unit(benchmark::kMicrosecond);
-BENCHMARK(EditsThenRays_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
+BW_SPARSE_DENSE(EditsThenRays_OctoBVH, ->Iterations(1)->Unit(benchmark::kMillisecond));
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
