@@ -262,6 +262,20 @@ TEST(OctoBvh, StructureIsCanonicalOverRandomOrdersAndInterleavings) {
   }
 }
 
+// Structure hash of a tree bulk-loaded from `tree`'s elements (what the canonical form must equal).
+uint64_t freshBuildHash(const OctoBvh& tree) {
+  std::vector<Aabb> b;
+  std::vector<uint32_t> f, p;
+  tree.forEachElement([&](uint32_t h) {
+    b.push_back(tree.bounds(h));
+    f.push_back(tree.filter(h));
+    p.push_back(tree.payload(h));
+  });
+  OctoBvh fresh;
+  fresh.bulkLoad(b, f, p);
+  return fresh.structureHash();
+}
+
 // After every few random edits the incrementally maintained tree equals a fresh bulk build.
 TEST(OctoBvh, RandomEditSequencesMatchFreshBuild) {
   SeededRandom r(99);
@@ -287,16 +301,7 @@ TEST(OctoBvh, RandomEditSequencesMatchFreshBuild) {
     }
     if (step % 250 == 0) {
       tree.validate();
-      std::vector<Aabb> b;
-      std::vector<uint32_t> f, p;
-      tree.forEachElement([&](uint32_t h) {
-        b.push_back(tree.bounds(h));
-        f.push_back(tree.filter(h));
-        p.push_back(tree.payload(h));
-      });
-      OctoBvh fresh;
-      fresh.bulkLoad(b, f, p);
-      ASSERT_EQ(tree.structureHash(), fresh.structureHash()) << "step " << step;
+      ASSERT_EQ(tree.structureHash(), freshBuildHash(tree)) << "step " << step;
     }
   }
 }
@@ -353,16 +358,7 @@ TEST(OctoBvh, GiantsAmongSmallBricksLiveInAForcedClusterAndMoveBack) {
 
   auto expectCanonical = [&](const char* when) {
     tree.validate();
-    std::vector<Aabb> b;
-    std::vector<uint32_t> f, pl;
-    tree.forEachElement([&](uint32_t h) {
-      b.push_back(tree.bounds(h));
-      f.push_back(tree.filter(h));
-      pl.push_back(tree.payload(h));
-    });
-    OctoBvh fresh;
-    fresh.bulkLoad(b, f, pl);
-    ASSERT_EQ(tree.structureHash(), fresh.structureHash()) << when;
+    ASSERT_EQ(tree.structureHash(), freshBuildHash(tree)) << when;
   };
   expectCanonical("after inserting the small bricks");
   SeededRandom r(12);
