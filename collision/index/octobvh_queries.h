@@ -3,6 +3,9 @@
 // hooks inline into the traversal loops.
 #include <algorithm>
 #include <bit>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace bw {
 
@@ -32,9 +35,42 @@ void OctoBvh::forEachHeld(const NodeCluster& cl, int s, F&& f) const {
 }
 
 namespace octobvh_detail {
+/// Asks for the cache lines of a cluster's bounds (its first 192 bytes) ahead of their use.
+inline void prefetchBounds(const octobvh::NodeCluster& cl) {
+  const char* p = reinterpret_cast<const char*>(&cl);
+  __builtin_prefetch(p);
+  __builtin_prefetch(p + 64);
+  __builtin_prefetch(p + 128);
+}
+
+/// Nodes counted in an 8-bit mask. note: std::popcount is a libgcc call on baseline x86-64
+/// (no POPCNT instruction without -mpopcnt); the table is one load.
+inline unsigned popcount8(unsigned bits) {
+  static constexpr auto kTable = [] {
+    std::array<uint8_t, 256> t{};
+    for (int i = 0; i < 256; ++i) t[size_t(i)] = uint8_t(std::popcount(unsigned(i)));
+    return t;
+  }();
+  return kTable[bits & 255u];
+}
+
+/// Bit o set when node o of the cluster matches the mask; the nodes a query may enter.
+inline unsigned filterMask(const octobvh::NodeCluster& ch, uint32_t mask) {
+#if defined(__SSE2__)
+  const __m128i m = _mm_set1_epi32(int(mask)), zero = _mm_setzero_si128();
+  const __m128i lo = _mm_cmpeq_epi32(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(ch.filter)), m), zero);
+  const __m128i hi = _mm_cmpeq_epi32(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(ch.filter + 4)), m), zero);
+  return ~(unsigned(_mm_movemask_ps(_mm_castsi128_ps(lo))) | unsigned(_mm_movemask_ps(_mm_castsi128_ps(hi))) << 4) & 255u;
+#else
+  unsigned cand = 0;
+  for (int o = 0; o < 8; ++o) cand |= unsigned((ch.filter[o] & mask) != 0) << o;
+  return cand;
+#endif
+}
+
 /// Bit o set when node o of the cluster matches the mask and its tight bounds overlap box.
-/// note: written as a branch-free loop over the SoA arrays so the compiler vectorises it.
-inline unsigned overlapMask(const octobvh::NodeCluster& ch, const Aabb& box, uint32_t mask, unsigned& candidates) {
+/// The portable form; overlapMask is the same, bit for bit, with SSE2 where the target has it.
+inline unsigned overlapMaskPortable(const octobvh::NodeCluster& ch, const Aabb& box, uint32_t mask, unsigned& candidates) {
   unsigned hits = 0, cand = 0;
   for (int o = 0; o < 8; ++o) {
     const bool match = (ch.filter[o] & mask) != 0;
@@ -45,6 +81,28 @@ inline unsigned overlapMask(const octobvh::NodeCluster& ch, const Aabb& box, uin
   }
   candidates = cand;
   return hits;
+}
+
+/// overlapMaskPortable for all 8 nodes in two halves of 4 (SSE2 is part of every x86-64).
+inline unsigned overlapMask(const octobvh::NodeCluster& ch, const Aabb& box, uint32_t mask, unsigned& candidates) {
+#if defined(__SSE2__)
+  const unsigned cand = filterMask(ch, mask);
+  candidates = cand;
+  if (!cand) return 0;
+  unsigned hits = 0;
+  for (int h = 0; h < 8; h += 4) {
+    __m128 ov = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(ch.minX + h), _mm_set1_ps(box.max.x())),
+                           _mm_cmpge_ps(_mm_loadu_ps(ch.maxX + h), _mm_set1_ps(box.min.x())));
+    ov = _mm_and_ps(ov, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(ch.minY + h), _mm_set1_ps(box.max.y())),
+                                   _mm_cmpge_ps(_mm_loadu_ps(ch.maxY + h), _mm_set1_ps(box.min.y()))));
+    ov = _mm_and_ps(ov, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(ch.minZ + h), _mm_set1_ps(box.max.z())),
+                                   _mm_cmpge_ps(_mm_loadu_ps(ch.maxZ + h), _mm_set1_ps(box.min.z()))));
+    hits |= unsigned(_mm_movemask_ps(ov)) << h;
+  }
+  return hits & cand;
+#else
+  return overlapMaskPortable(ch, box, mask, candidates);
+#endif
 }
 
 inline bool elementOverlaps(const octobvh::ElementRecord& r, const Aabb& b) {
@@ -82,11 +140,14 @@ void OctoBvh::walkOverlap(const Aabb& outer, uint32_t mask, QueryStats* stats, O
       cl.forEachSubCluster(s, [&](uint32_t c) {
         unsigned candidates;
         unsigned hits = overlapMask(clusters_[c], outer, mask, candidates);
-        tests += unsigned(std::popcount(candidates));
+        tests += popcount8(candidates);
+        const NodeCluster& ch = clusters_[c];
         while (hits) {
           const int o = std::countr_zero(hits);
           hits &= hits - 1;
-          if (accept(c, o)) stack[sp++] = nodeRef(c, o);
+          if (!accept(c, o)) continue;
+          stack[sp++] = nodeRef(c, o);
+          if (ch.child[o] != kInvalidIndex) prefetchBounds(clusters_[ch.child[o]]);
         }
       });
     }
@@ -162,6 +223,113 @@ inline std::array<uint8_t, 8> OctoBvh::rayChildOrder(const Vec3f& dir) {
 }
 
 namespace octobvh_detail {
+/// A ray (or sweep: a ray against boxes grown by `grow`) set up for testing 8 nodes at once.
+struct RaySlabs {
+  float origin[3], invDir[3], grow[3];
+  bool parallel[3];  // the ray never leaves this axis's slab: tested by containment
+  static RaySlabs of(const Ray& ray, const Vec3f& grow) {
+    RaySlabs r{};
+    for (int i = 0; i < 3; ++i) {
+      r.origin[i] = ray.origin[i];
+      r.invDir[i] = ray.invDir[i];
+      r.grow[i] = grow[i];
+      r.parallel[i] = (ray.parallelMask >> i) & 1u;
+    }
+    return r;
+  }
+  /// intersectRayAabb(ray, record's bounds grown by `grow`, 0, limit, t), read straight from the
+  /// record's floats (the same operations in the same order).
+  bool enters(const octobvh::ElementRecord& e, float limit, float& t) const {
+    float t0 = 0.f, t1 = limit;
+    for (int i = 0; i < 3; ++i) {
+      const float bmin = e.min[i] - grow[i], bmax = e.max[i] + grow[i];
+      if (parallel[i]) {
+        if (origin[i] < bmin || origin[i] > bmax) return false;
+        continue;
+      }
+      float a = (bmin - origin[i]) * invDir[i], c = (bmax - origin[i]) * invDir[i];
+      if (a > c) std::swap(a, c);
+      t0 = a > t0 ? a : t0;
+      t1 = c < t1 ? c : t1;
+      if (t0 > t1) return false;
+    }
+    t = t0;
+    return true;
+  }
+};
+
+/// Bit o set when node o of the cluster matches the mask and its (grown) tight bounds meet the
+/// ray within [0, limit] (before limit once ties are pruned), with its entry t in t[o] for the
+/// nodes hit: intersectRayAabb's slab test, bit for bit. The portable form; rayMask is the same
+/// with SSE2.
+inline unsigned rayMaskPortable(const octobvh::NodeCluster& ch, const RaySlabs& r, float limit, bool tiesPruned,
+                                uint32_t mask, float t[8], unsigned& candidates) {
+  const unsigned cand = filterMask(ch, mask);
+  candidates = cand;
+  const float* lo[3] = {ch.minX, ch.minY, ch.minZ};
+  const float* hi[3] = {ch.maxX, ch.maxY, ch.maxZ};
+  float t0[8], t1[8];
+  bool inside[8];
+  for (int o = 0; o < 8; ++o) t0[o] = 0.f, t1[o] = limit, inside[o] = true;
+  for (int a = 0; a < 3; ++a) {
+    const float g = r.grow[a], org = r.origin[a], inv = r.invDir[a];
+    if (r.parallel[a]) {
+      for (int o = 0; o < 8; ++o) inside[o] = inside[o] & (org >= lo[a][o] - g) & (org <= hi[a][o] + g);
+      continue;
+    }
+    for (int o = 0; o < 8; ++o) {
+      const float p = (lo[a][o] - g - org) * inv, q = (hi[a][o] + g - org) * inv;
+      const float n = p > q ? q : p, f = p > q ? p : q;
+      t0[o] = n > t0[o] ? n : t0[o];
+      t1[o] = f < t1[o] ? f : t1[o];
+    }
+  }
+  unsigned hits = 0;
+  for (int o = 0; o < 8; ++o) {
+    const bool hit = inside[o] & (t0[o] <= t1[o]) & !(tiesPruned & (t0[o] == limit));
+    hits |= unsigned(hit) << o;
+    t[o] = t0[o];
+  }
+  return hits & cand;
+}
+
+/// rayMaskPortable for all 8 nodes in two halves of 4: minps/maxps with these operand orders
+/// are exactly its ternaries.
+inline unsigned rayMask(const octobvh::NodeCluster& ch, const RaySlabs& r, float limit, bool tiesPruned, uint32_t mask,
+                        float t[8], unsigned& candidates) {
+#if defined(__SSE2__)
+  const unsigned cand = filterMask(ch, mask);
+  candidates = cand;
+  if (!cand) return 0;
+  const float* lo[3] = {ch.minX, ch.minY, ch.minZ};
+  const float* hi[3] = {ch.maxX, ch.maxY, ch.maxZ};
+  unsigned hits = 0;
+  for (int h = 0; h < 8; h += 4) {
+    __m128 t0 = _mm_setzero_ps(), t1 = _mm_set1_ps(limit);
+    __m128 inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (int a = 0; a < 3; ++a) {
+      const __m128 g = _mm_set1_ps(r.grow[a]), org = _mm_set1_ps(r.origin[a]);
+      const __m128 bmin = _mm_sub_ps(_mm_loadu_ps(lo[a] + h), g), bmax = _mm_add_ps(_mm_loadu_ps(hi[a] + h), g);
+      if (r.parallel[a]) {
+        inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmpge_ps(org, bmin), _mm_cmple_ps(org, bmax)));
+        continue;
+      }
+      const __m128 inv = _mm_set1_ps(r.invDir[a]);
+      const __m128 p = _mm_mul_ps(_mm_sub_ps(bmin, org), inv), q = _mm_mul_ps(_mm_sub_ps(bmax, org), inv);
+      t0 = _mm_max_ps(_mm_min_ps(q, p), t0);  // n = p > q ? q : p; t0 = n > t0 ? n : t0
+      t1 = _mm_min_ps(_mm_max_ps(p, q), t1);  // f = p > q ? p : q; t1 = f < t1 ? f : t1
+    }
+    __m128 hit = _mm_and_ps(inside, _mm_cmple_ps(t0, t1));
+    if (tiesPruned) hit = _mm_andnot_ps(_mm_cmpeq_ps(t0, _mm_set1_ps(limit)), hit);
+    _mm_storeu_ps(t + h, t0);
+    hits |= unsigned(_mm_movemask_ps(hit)) << h;
+  }
+  return hits & cand;
+#else
+  return rayMaskPortable(ch, r, limit, tiesPruned, mask, t, candidates);
+#endif
+}
+
 /// Shared ray traversal: calls onElement(e, tEnterBox) for elements whose bounds the ray enters
 /// before the current limit; onElement returns the new limit (pruning farther nodes) and may
 /// set `stop` to end the traversal. Once `tiesPruned` is set, nodes and elements entered exactly
@@ -180,6 +348,7 @@ void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::arr
   ++tests;
   float t;
   if (!intersectRayAabb(ray, root.bounds(0).expanded(grow), 0.f, limit, t)) return;
+  const RaySlabs slabs = RaySlabs::of(ray, grow);
   RayEntry stack[kStackSize];
   int sp = 0;
   stack[sp++] = {nodeRef(rootC, 0), t};
@@ -195,20 +364,22 @@ void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::arr
       ++tests;
       ++elementTests;
       float te;
-      if (intersectRayAabb(ray, r.bounds().expanded(grow), 0.f, limit, te) && !(tiesPruned && te == limit))
-        limit = onElement(e, te, stop);
+      if (slabs.enters(r, limit, te) && !(tiesPruned && te == limit)) limit = onElement(e, te, stop);
     });
     // The forced cluster first, then the children, each pushed far-to-near: the nearest child is
     // popped first.
     auto push = [&](uint32_t c) {
+      float tc[8];
+      unsigned candidates;
+      const unsigned hits = rayMask(tree.cluster(c), slabs, limit, tiesPruned, mask, tc, candidates);
+      tests += popcount8(candidates);
       const NodeCluster& ch = tree.cluster(c);
       for (int k = 7; k >= 0; --k) {
         const int o = order[k];
-        if (!(ch.filter[o] & mask)) continue;
-        ++tests;
-        float tc;
-        if (intersectRayAabb(ray, ch.bounds(o).expanded(grow), 0.f, limit, tc) && !(tiesPruned && tc == limit))
-          stack[sp++] = {nodeRef(c, o), tc};
+        if (!(hits >> o & 1u)) continue;
+        stack[sp++] = {nodeRef(c, o), tc[o]};
+        // note: the node's children are what its visit reads first; fetch their bounds now.
+        if (ch.child[o] != kInvalidIndex) prefetchBounds(tree.cluster(ch.child[o]));
       }
     };
     if (cl.child[s] == kInvalidIndex) continue;
