@@ -10,6 +10,8 @@
 // Edit/<Index>: insert, remove and update at 1M (ns per op). Overlap2m/<Index>, RayClosest200m/
 // <Index>, LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs
 // reversed child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again.
+// The 1M rows run on the sparse build (`/sparse`) and on the dense one (`/dense`: the same bricks
+// packed 200x tighter, bw::kDenseBuild); Load rows take (bricks, dense 0/1).
 //
 // btDbvt comes in two setups. `btDbvt` (naive) is the tree as incremental insert() leaves it.
 // `btDbvtOptimized` is what a Bullet user does after a bulk build: the same inserts, then
