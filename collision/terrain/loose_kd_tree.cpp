@@ -45,7 +45,7 @@ void LooseKdTree::clear() {
   depth_ = 0;
 }
 
-void LooseKdTree::build(const TriangleMeshView& mesh, KdTreeBuilder& b) {
+void LooseKdTree::build(const TriangleMeshView& mesh, KdTreeBuilder& b, KdHeightBoundsMode heightBounds) {
   if (mesh.triangleCount > kMaxTriangles) {
     throw InvalidInput("LooseKdTree::build: mesh.triangleCount is " + std::to_string(mesh.triangleCount) +
                        ", above the 2^29 limit of 30-bit node indices");
@@ -69,12 +69,50 @@ void LooseKdTree::build(const TriangleMeshView& mesh, KdTreeBuilder& b) {
     all.add(r);
   }
   bounds_ = all.bounds;
+  heights_.clear();
+  heightAxis_ = -1;
+  const Vec3f extent = bounds_.extent();
+  int shortest = 0;
+  for (int i = 1; i < 3; ++i)
+    if (extent[i] < extent[shortest]) shortest = i;
+  if (heightBounds == KdHeightBoundsMode::Auto && n >= kHeightBoundsMinTriangles &&
+      extent[shortest] * 4.f <= extent.maxCoeff()) {
+    heightAxis_ = shortest;
+    b.heightLo.resize(2 * size_t(n));  // a tree over n triangles has at most 2n - 1 nodes
+    b.heightHi.resize(2 * size_t(n));
+  }
   // note: a tree over n triangles has at most 2n - 1 nodes and usually ~1.1n; reserve the
   // usual case and trim afterwards so bytes() is what is actually held.
   nodes_.reserve(size_t(n) + n / 4 + 1);
   nodes_.push_back({});
   depth_ = buildNode(0, 0, n, all.bounds, all.midSum, b, 1);
+  if (heightAxis_ >= 0) quantiseHeights(b);
   layoutInTreelets(b);
+}
+
+void LooseKdTree::quantiseHeights(KdTreeBuilder& b) {
+  const int a = heightAxis_;
+  const float range = bounds_.max[a] - bounds_.min[a];
+  heightBase_ = bounds_.min[a];
+  // note: 65534 steps over the range, so code 65535 lies a whole step above the top: more than
+  // any rounding of base + q * step when the range is not tiny against the base.
+  heightStep_ = range > 0.f ? range / 65534.f : 1.f;
+  heights_.resize(nodes_.size());
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    const float lo = b.heightLo[i], hi = b.heightHi[i];
+    float qlo = std::floor((lo - heightBase_) / heightStep_), qhi = std::ceil((hi - heightBase_) / heightStep_);
+    uint16_t dlo = uint16_t(std::clamp(qlo, 0.f, 65535.f)), dhi = uint16_t(std::clamp(qhi, 0.f, 65535.f));
+    // Rounded outwards as the query will dequantise them, whatever the division's rounding did.
+    while (dlo > 0 && heightOf(dlo) > lo) --dlo;
+    while (dhi < 65535 && heightOf(dhi) < hi) ++dhi;
+    if (heightOf(dlo) > lo || heightOf(dhi) < hi) {
+      // A range too small against its base to code in 16 bits (far from the origin): no bounds.
+      heights_.clear();
+      heightAxis_ = -1;
+      return;
+    }
+    heights_[i] = {dlo, dhi};
+  }
 }
 
 void LooseKdTree::layoutInTreelets(KdTreeBuilder& b) {
@@ -94,6 +132,13 @@ void LooseKdTree::layoutInTreelets(KdTreeBuilder& b) {
   out.clear();
   out.reserve(nodes_.size());
   out.push_back(root);
+  const bool heights = !heights_.empty();
+  std::vector<KdHeightBounds>& outHeights = b.heightLayout;
+  outHeights.clear();
+  if (heights) {
+    outHeights.reserve(heights_.size());
+    outHeights.push_back(heights_[0]);
+  }
   using Pending = KdTreeBuilder::PendingPair;  // a pair of nodes_ and the `out` node pointing at it
   std::vector<Pending>& waiting = b.pending;
   waiting.clear();
@@ -112,6 +157,10 @@ void LooseKdTree::layoutInTreelets(KdTreeBuilder& b) {
       const uint32_t base = uint32_t(out.size());
       out.push_back(nodes_[treelet[i]]);
       out.push_back(nodes_[treelet[i] + 1]);
+      if (heights) {
+        outHeights.push_back(heights_[treelet[i]]);
+        outHeights.push_back(heights_[treelet[i] + 1]);
+      }
       out[parents[i]].bits = (base << 2) | out[parents[i]].axis();
       for (uint32_t k = 0; k < 2; ++k) {
         const KdNode& n = out[base + k];
@@ -128,12 +177,17 @@ void LooseKdTree::layoutInTreelets(KdTreeBuilder& b) {
     std::reverse(waiting.begin() + std::ptrdiff_t(frontierBegin), waiting.end());
   }
   nodes_.swap(out);  // out was reserved to the exact size: no slack is kept
+  if (heights) heights_.swap(outHeights);
 }
 
 uint32_t LooseKdTree::buildNode(uint32_t node, uint32_t begin, uint32_t end, const Aabb& bounds,
                                 const double (&midSum)[3], KdTreeBuilder& b, uint32_t depth) {
   const uint32_t count = end - begin;
   Record* rec = b.records.data();
+  if (heightAxis_ >= 0) {
+    b.heightLo[node] = bounds.min[heightAxis_];
+    b.heightHi[node] = bounds.max[heightAxis_];
+  }
   if (count <= 2) {
     nodes_[node] = {rec[begin].id, count == 2 ? rec[begin + 1].id : 0u, (count << 2) | KdNode::kLeafAxis};
     return depth;
@@ -242,6 +296,11 @@ bool LooseKdTree::raycastImpl(const Vertices& vertices, const Index* indices, co
 
   const WatertightRay wr = WatertightRay::make(ray.origin, ray.dir);
   const KdNode* nodes = nodes_.data();
+  // Height bounds (wide meshes): the segment is clipped to each node's range on that axis.
+  const KdHeightBounds* heights = heights_.empty() ? nullptr : heights_.data();
+  const int ha = heightAxis_;
+  const bool hParallel = ha >= 0 && (ray.parallelMask & (1u << ha));
+  const float hOrigin = ha >= 0 ? ray.origin[ha] : 0.f, hInv = ha >= 0 ? ray.invDir[ha] : 0.f;
   RaySegment stack[kMaxDepth + 1];
   uint32_t sp = 0;
   RaySegment s{0, tMin, tMax};
@@ -253,7 +312,23 @@ bool LooseKdTree::raycastImpl(const Vertices& vertices, const Index* indices, co
     const KdNode n = nodes[s.node];
     if constexpr (kCount) ++*nodesVisited;
     const uint32_t axis = n.axis();
-    if (axis == KdNode::kLeafAxis) {
+    bool inRange = true;
+    if (heights) {
+      const KdHeightBounds hb = heights[s.node];
+      const float lo = heightOf(hb.lo) - pad, hi = heightOf(hb.hi) + pad;
+      if (hParallel) {
+        inRange = hOrigin >= lo && hOrigin <= hi;
+      } else {
+        float ta = (lo - hOrigin) * hInv, tb = (hi - hOrigin) * hInv;
+        if (ta > tb) std::swap(ta, tb);
+        s.tMin = std::max(s.tMin, ta);
+        s.tMax = std::min(s.tMax, tb);
+        inRange = s.tMin <= s.tMax && s.tMin <= best;
+      }
+    }
+    if (!inRange) {
+      // The ray passes above or below everything in this subtree: on to the next segment.
+    } else if (axis == KdNode::kLeafAxis) {
       const uint32_t tris[2] = {n.word0, n.word1};
       for (uint32_t i = 0; i < n.payload(); ++i) {
         const Index* tri = indices + 3 * size_t(tris[i]);
@@ -330,11 +405,17 @@ std::string LooseKdTree::validate(const TriangleMeshView& mesh) const {
   walk.push_back(root);
   uint32_t maxDepth = 0;
   while (!walk.empty()) {
-    const Item it = walk.back();
+    Item it = walk.back();
     walk.pop_back();
     if (it.node >= nodes_.size()) return "node index out of range";
     maxDepth = std::max(maxDepth, it.depth);
     const KdNode& n = nodes_[it.node];
+    if (heightAxis_ >= 0) {
+      // The subtree's triangles must lie within its height bounds too.
+      if (heights_.size() != nodes_.size()) return "height bounds not one per node";
+      it.lo[heightAxis_] = std::max(it.lo[heightAxis_], heightOf(heights_[it.node].lo));
+      it.hi[heightAxis_] = std::min(it.hi[heightAxis_], heightOf(heights_[it.node].hi));
+    }
     if (n.axis() == KdNode::kLeafAxis) {
       if (n.payload() > 2 || n.payload() == 0) return "leaf with a bad triangle count";
       const uint32_t tris[2] = {n.word0, n.word1};

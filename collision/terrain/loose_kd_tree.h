@@ -16,6 +16,14 @@
 /// breadth-first, contiguously) so a descent touches fewer cache lines on big trees.
 /// Queries run an explicit stack of kMaxDepth + 1 entries on the C++ stack: no heap, and the
 /// build proves the depth bound (depth() <= kMaxDepth always holds).
+/// Height bounds: on a wide mesh (a heightfield: >= kHeightBoundsMinTriangles triangles, the
+/// shortest axis of its bounds at most a quarter of the longest) the splits almost never cut the
+/// short axis, so a descending ray walks every node under its footprint from where it starts,
+/// tens of metres above the ground. Such trees also keep, per node, its subtree's range on the
+/// short axis in 16 bits of the root's range (4 bytes a node, rounded outwards), and a ray clips
+/// its segment to it: it skips the nodes it passes over. Box queries do not read them: a box on
+/// the surface spans every node's range it meets, and the second array's cache lines cost
+/// more than they cut (2 m boxes: 0.28x -> 0.53x of Bullet's time, measured).
 /// Thread safety: queries are const and may run concurrently.
 #include <bit>
 #include <cstddef>
@@ -50,6 +58,18 @@ struct KdNode {
 };
 static_assert(sizeof(KdNode) == 12, "the article's 12-byte node");
 
+/// A node's subtree range on the tree's height axis, in steps of the root's range: the real
+/// range lies within [base + lo * step, base + hi * step] (lo rounded down, hi up).
+struct KdHeightBounds {
+  uint16_t lo;  // 2
+  uint16_t hi;  // 4
+};
+static_assert(sizeof(KdHeightBounds) == 4);
+
+/// Whether a build may add height bounds: Auto adds them to wide meshes (see above), Off never
+/// (for measuring what they bring).
+enum class KdHeightBoundsMode : uint8_t { Auto, Off };
+
 /// Closest hit of a ray against a tree's triangles.
 struct KdRayHit {
   float t;            ///< ray parameter of the hit (units of |dir|)
@@ -73,6 +93,8 @@ class KdTreeBuilder {
     uint32_t parent;   // 4
   };
   std::vector<PendingPair> pending;  ///< scratch for the treelet layout pass
+  std::vector<float> heightLo, heightHi;     ///< per built node: its subtree's range on the height axis
+  std::vector<KdHeightBounds> heightLayout;  ///< scratch: height bounds in the treelet order
 };
 
 class LooseKdTree {
@@ -82,10 +104,13 @@ class LooseKdTree {
   static constexpr uint32_t kMaxDepth = 80;
   /// Largest triangle count (30-bit child indices; nodes <= triangles).
   static constexpr uint32_t kMaxTriangles = (1u << 29);
+  /// Smallest mesh that gets height bounds (below it a ray visits few nodes anyway, and chunk
+  /// meshes keep the article's 12 bytes a node).
+  static constexpr uint32_t kHeightBoundsMinTriangles = 4096;
 
   /// Builds over all triangles of `mesh`, replacing any previous tree. Throws InvalidInput for
   /// more than kMaxTriangles triangles.
-  void build(const TriangleMeshView& mesh, KdTreeBuilder& builder);
+  void build(const TriangleMeshView& mesh, KdTreeBuilder& builder, KdHeightBoundsMode heightBounds = KdHeightBoundsMode::Auto);
   /// Frees the nodes.
   void clear();
 
@@ -104,8 +129,11 @@ class LooseKdTree {
   uint32_t depth() const { return depth_; }
   /// Node array.
   const std::vector<KdNode>& nodes() const { return nodes_; }
-  /// Bytes of the tree alone (nodes + bounds), not counting the mesh.
-  size_t bytes() const { return nodes_.size() * sizeof(KdNode) + sizeof(Aabb); }
+  /// Whether the tree keeps height bounds (a wide mesh), and on which axis (-1: none).
+  bool hasHeightBounds() const { return heightAxis_ >= 0; }
+  int heightAxis() const { return heightAxis_; }
+  /// Bytes of the tree alone (nodes, height bounds, bounds), not counting the mesh.
+  size_t bytes() const { return nodes_.size() * sizeof(KdNode) + heights_.size() * sizeof(KdHeightBounds) + sizeof(Aabb); }
 
   /// Checks the structural invariants (every triangle in exactly one leaf, children inside
   /// their parent's planes, depth). Returns an empty string or the first violation.
@@ -114,6 +142,8 @@ class LooseKdTree {
  private:
   static float splitOf(uint32_t word) { return std::bit_cast<float>(word); }
   void layoutInTreelets(KdTreeBuilder& b);
+  void quantiseHeights(KdTreeBuilder& b);
+  float heightOf(uint16_t q) const { return heightBase_ + float(q) * heightStep_; }
   uint32_t buildNode(uint32_t node, uint32_t begin, uint32_t end, const Aabb& bounds, const double (&midSum)[3],
                      KdTreeBuilder& b, uint32_t depth);
   template <bool kCount>
@@ -122,6 +152,9 @@ class LooseKdTree {
   bool raycastImpl(const Vertices& vertices, const Index* indices, const Ray& ray, KdRayHit& hit, uint32_t* nodesVisited) const;
 
   std::vector<KdNode> nodes_;
+  std::vector<KdHeightBounds> heights_;  ///< per node when heightAxis_ >= 0, else empty
+  int heightAxis_ = -1;
+  float heightBase_ = 0.f, heightStep_ = 0.f;  ///< dequantisation: base + q * step
   Aabb bounds_ = Aabb::empty();
   uint32_t depth_ = 0;
 };

@@ -131,7 +131,8 @@ struct RaySample {
 
 btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
 
-enum Side { kKdTree = 0, kBtQuantized = 1, kBtNonQuantized = 2 };
+// KdTreeNoHeightBounds: the same tree built without height bounds (what they bring, measured).
+enum Side { kKdTree = 0, kBtQuantized = 1, kBtNonQuantized = 2, kKdTreeNoHeightBounds = 3 };
 
 // ---------------------------------------------------------------------------------------------
 // Bitmask broadphase
@@ -304,9 +305,9 @@ void BM_Heightfield1M_Build(benchmark::State& state, int side) {
   size_t treeBytes = 0;
   KdTreeBuilder builder;
   for (auto _ : state) {
-    if (side == kKdTree) {
+    if (side == kKdTree || side == kKdTreeNoHeightBounds) {
       LooseKdTree tree;
-      tree.build(v, builder);
+      tree.build(v, builder, side == kKdTree ? KdHeightBoundsMode::Auto : KdHeightBoundsMode::Off);
       treeBytes = tree.bytes();
       state.counters["depth"] = double(tree.depth());
       state.counters["nodes_per_triangle"] = double(tree.nodes().size()) / double(v.triangleCount);
@@ -321,7 +322,7 @@ void BM_Heightfield1M_Build(benchmark::State& state, int side) {
 }
 
 struct HeightfieldSides {
-  LooseKdTree kd;
+  LooseKdTree kd, kdPlain;  // with height bounds (the heightfield is wide) and without
   std::unique_ptr<BulletBvhMesh> q, nq;
   std::vector<RaySample> rays;
   std::vector<Aabb> boxes;
@@ -333,6 +334,7 @@ const HeightfieldSides& heightfieldSides() {
     const HeightfieldMesh& hf = heightfield();
     KdTreeBuilder b;
     s.kd.build(hf.view(), b);
+    s.kdPlain.build(hf.view(), b, KdHeightBoundsMode::Off);
     s.q = std::make_unique<BulletBvhMesh>(hf.view(), true);
     s.nq = std::make_unique<BulletBvhMesh>(hf.view(), false);
     std::mt19937 rng(13);
@@ -362,9 +364,9 @@ void BM_Heightfield1M_Raycast(benchmark::State& state, int side) {
   size_t i = 0, hits = 0;
   for (auto _ : state) {
     const RaySample& r = s.rays[i++ & 4095];
-    if (side == kKdTree) {
+    if (side == kKdTree || side == kKdTreeNoHeightBounds) {
       KdRayHit h;
-      hits += s.kd.raycastClosest(v, Ray::make(r.origin, r.dir, r.length), h);
+      hits += (side == kKdTree ? s.kd : s.kdPlain).raycastClosest(v, Ray::make(r.origin, r.dir, r.length), h);
     } else {
       BulletClosestHit cb(bt(r.origin), bt(r.origin + r.dir * r.length));
       (side == kBtQuantized ? s.q : s.nq)->shape->performRaycast(&cb, cb.m_from, cb.m_to);
@@ -373,6 +375,17 @@ void BM_Heightfield1M_Raycast(benchmark::State& state, int side) {
   }
   state.counters["hit_fraction"] = double(hits) / double(state.iterations());
   state.counters["closest_hit_disagreements"] = double(s.disagreements);
+  if (side == kKdTree || side == kKdTreeNoHeightBounds) {
+    // Nodes visited per ray over the 4096 rays, counted outside the timed loop.
+    uint64_t visited = 0;
+    for (const RaySample& r : s.rays) {
+      KdRayHit h;
+      uint32_t n = 0;
+      (side == kKdTree ? s.kd : s.kdPlain).raycastClosestCounted(v, Ray::make(r.origin, r.dir, r.length), h, n);
+      visited += n;
+    }
+    state.counters["nodes_visited"] = double(visited) / double(s.rays.size());
+  }
 }
 
 void BM_Heightfield1M_AabbQuery2m(benchmark::State& state, int side) {
@@ -431,9 +444,11 @@ BENCHMARK_CAPTURE(BM_ChunkMeshes_Raycast, KdTree, kKdTree);
 BENCHMARK_CAPTURE(BM_ChunkMeshes_Raycast, btBvhQuantized, kBtQuantized);
 BENCHMARK_CAPTURE(BM_ChunkMeshes_Raycast, btBvhNonQuantized, kBtNonQuantized);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Build, KdTree, kKdTree)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(BM_Heightfield1M_Build, KdTreeNoHeightBounds, kKdTreeNoHeightBounds)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Build, btBvhQuantized, kBtQuantized)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Build, btBvhNonQuantized, kBtNonQuantized)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, KdTree, kKdTree);
+BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, KdTreeNoHeightBounds, kKdTreeNoHeightBounds);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, btBvhQuantized, kBtQuantized);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, btBvhNonQuantized, kBtNonQuantized);
 BENCHMARK_CAPTURE(BM_Heightfield1M_AabbQuery2m, KdTree, kKdTree);

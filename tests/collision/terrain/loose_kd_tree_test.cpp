@@ -247,6 +247,109 @@ TEST(LooseKdTree, EarlyExitVisitsFewerNodesThanTheWholeTree) {
   EXPECT_LT(visited, tree.nodes().size() / 10);
 }
 
+/// A heightfield of n x n quads moved by `offset` (wide: its heights span a few metres).
+SoupMesh wideHeightfield(uint32_t n, float amplitude, uint32_t seed, const Vec3f& offset) {
+  const HeightfieldMesh h = makeHeightfieldMesh(n, 1.f, amplitude, seed);
+  SoupMesh m;
+  for (const Vec3f& v : h.vertices) m.vertices.push_back(v + offset);
+  m.indices = h.indices;
+  return m;
+}
+
+TEST(LooseKdTree, HeightBoundsOnWideMeshesKeepEveryAnswerAndSkipTheNodesARayPassesOver) {
+  KdTreeBuilder builder;
+  const Vec3f offsets[] = {Vec3f::Zero(), Vec3f(3000.f, -250.f, -4000.f)};
+  for (uint32_t seed : {3u, 4u}) {
+    for (const Vec3f& offset : offsets) {
+      const SoupMesh m = wideHeightfield(96, 10.f, seed, offset);  // 18,432 triangles, heights within +-10 m
+      LooseKdTree bounded, plain;
+      bounded.build(m.view(), builder);
+      plain.build(m.view(), builder, KdHeightBoundsMode::Off);
+      ASSERT_TRUE(bounded.hasHeightBounds());
+      ASSERT_EQ(bounded.heightAxis(), 1);
+      ASSERT_FALSE(plain.hasHeightBounds());
+      ASSERT_EQ(bounded.validate(m.view()), "");
+      EXPECT_EQ(bounded.bytes(), plain.bytes() + plain.nodes().size() * sizeof(KdHeightBounds));
+
+      // Rays from 1-30 m above the surface, down with a slant (the benchmark's); rays from 1-10 m
+      // above the ground below them at a shallow angle, over valleys and hills before they land
+      // (those count nodes); then any direction from anywhere around the field.
+      std::mt19937 rng(seed * 7 + uint32_t(offset.x()));
+      std::uniform_real_distribution<float> xz(-4.f, 100.f), up(1.f, 30.f), low(1.f, 10.f), slant(-0.6f, 0.6f),
+          shallow(0.5f, 2.f), y(-8.f, 8.f), d(-1.f, 1.f);
+      uint64_t visitedBounded = 0, visitedPlain = 0;
+      int hits = 0;
+      for (int q = 0; q < 1200; ++q) {
+        Vec3f o, dir;
+        if (q < 400) {
+          o = Vec3f(xz(rng), 10.f + up(rng), xz(rng));
+          dir = Vec3f(slant(rng), -1.f, slant(rng));
+        } else if (q < 800) {
+          o = Vec3f(xz(rng), 0.f, xz(rng));
+          o.y() = heightfieldHeight(o.x(), o.z(), 10.f, seed) + low(rng);
+          const float sx = o.x() < 48.f ? 1.f : -1.f, sz = o.z() < 48.f ? 1.f : -1.f;  // towards the middle
+          dir = Vec3f(sx * shallow(rng), -1.f, sz * shallow(rng));
+        } else {
+          o = Vec3f(xz(rng), y(rng), xz(rng));
+          dir = Vec3f(d(rng), d(rng) * (q % 3 == 0 ? 0.f : 1.f), d(rng));  // a third level with the field
+          if (q % 7 == 0) dir = Vec3f(0, q % 2 ? 1.f : -1.f, 0);
+          if (dir.squaredNorm() == 0.f) dir = Vec3f(1, 0, 0);
+        }
+        const Ray ray = Ray::make(o + offset, dir, q % 5 == 0 ? 20.f : 300.f);
+        float want;
+        const bool wantHit = bruteRay(m.view(), ray, want);
+        KdRayHit got{}, gotPlain{};
+        uint32_t vb = 0, vp = 0;
+        ASSERT_EQ(bounded.raycastClosestCounted(m.view(), ray, got, vb), wantHit) << "ray " << q;
+        ASSERT_EQ(plain.raycastClosestCounted(m.view(), ray, gotPlain, vp), wantHit) << "ray " << q;
+        if (wantHit) {
+          ASSERT_EQ(got.t, want) << "ray " << q;
+          ASSERT_EQ(got.triangle, gotPlain.triangle) << "ray " << q;
+          ++hits;
+        }
+        if (q >= 400 && q < 800 && q % 5 != 0) visitedBounded += vb, visitedPlain += vp;
+      }
+      EXPECT_GT(hits, 500);
+      // The shallow rays pass over metres of lower ground before they land: the bounds must cut
+      // the nodes they visit by a third or more (about half, measured).
+      EXPECT_LT(visitedBounded * 3, visitedPlain * 2) << visitedBounded << " against " << visitedPlain;
+
+      // Boxes from 0.2 to 20 m around the surface and above it: the same triangles as brute force.
+      std::uniform_real_distribution<float> size(0.1f, 10.f), lift(-2.f, 12.f);
+      size_t reported = 0;
+      for (int q = 0; q < 300; ++q) {
+        Vec3f c(xz(rng), 0.f, xz(rng));
+        c.y() = heightfieldHeight(c.x(), c.z(), 10.f, seed) + lift(rng);
+        const Vec3f half(size(rng), size(rng) * 0.3f, size(rng));
+        const Aabb box{c + offset - half, c + offset + half};
+        std::vector<uint32_t> got;
+        bounded.queryAabb(m.view(), box, [&](uint32_t t) { got.push_back(t); });
+        std::sort(got.begin(), got.end());
+        ASSERT_EQ(got, bruteAabb(m.view(), box)) << "box " << q;
+        reported += got.size();
+      }
+      EXPECT_GT(reported, 1000u);
+    }
+  }
+}
+
+TEST(LooseKdTree, NoHeightBoundsOnSmallOrBoxyMeshes) {
+  KdTreeBuilder builder;
+  LooseKdTree tree;
+  const SoupMesh small = wideHeightfield(40, 3.f, 1, Vec3f::Zero());  // 3200 triangles
+  tree.build(small.view(), builder);
+  EXPECT_FALSE(tree.hasHeightBounds());
+  const SoupMesh boxy = randomSoup(3, 6000, 50.f);
+  tree.build(boxy.view(), builder);
+  EXPECT_FALSE(tree.hasHeightBounds());
+  const SoupMesh wide = wideHeightfield(48, 3.f, 1, Vec3f::Zero());  // 4608 triangles
+  tree.build(wide.view(), builder);
+  EXPECT_TRUE(tree.hasHeightBounds());
+  tree.build(boxy.view(), builder);  // a rebuild drops them
+  EXPECT_FALSE(tree.hasHeightBounds());
+  EXPECT_EQ(tree.validate(boxy.view()), "");
+}
+
 TEST(LooseKdTree, DepthBoundedOnDegenerateInputs) {
   // Every triangle has the same midpoint: the mean split puts all on one side, the median
   // fallback must still split evenly and terminate.
