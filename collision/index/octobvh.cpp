@@ -21,25 +21,6 @@ constexpr int8_t kEmptyMinLevel = -128;
 
 }  // namespace
 
-// ---------------------------------------------------------------- cubes
-
-int OctoBvh::Cube::childSlotFor(const double c[3]) const {
-  const double half = pow2(level - 1);
-  return (c[0] >= origin[0] + half ? 1 : 0) | (c[1] >= origin[1] + half ? 2 : 0) | (c[2] >= origin[2] + half ? 4 : 0);
-}
-
-OctoBvh::Cube OctoBvh::Cube::child(int slot) const {
-  const double half = pow2(level - 1);
-  return {{origin[0] + ((slot & 1) ? half : 0.0), origin[1] + ((slot & 2) ? half : 0.0),
-           origin[2] + ((slot & 4) ? half : 0.0)},
-          level - 1};
-}
-
-OctoBvh::Cube OctoBvh::rootCube() const {
-  const double o = -std::ldexp(1.0, rootLevel_ - 1);
-  return {{o, o, o}, rootLevel_};
-}
-
 // ---------------------------------------------------------------- construction
 
 OctoBvh::OctoBvh(Config config)
@@ -109,18 +90,6 @@ void OctoBvh::reserveHeadroom(const char* context) const {
 }
 
 // ---------------------------------------------------------------- held elements
-
-uint32_t OctoBvh::heldCount(uint32_t c, int s) const {
-  const NodeCluster& cl = clusters_[c];
-  if (cl.numHeld[s] == kForcedCluster) return 0;
-  return cl.numHeld[s] == kOverflow ? overflow_[cl.leaf[s]].count : cl.numHeld[s];
-}
-
-uint32_t OctoBvh::subtreeCount(uint32_t c, int s) const {
-  uint32_t n = heldCount(c, s);
-  clusters_[c].forEachSubCluster(s, [&](uint32_t sub) { n += clusters_[sub].childTotal; });
-  return n;
-}
 
 void OctoBvh::heldAdd(uint32_t c, int s, uint32_t e) {
   NodeCluster& cl = clusters_[c];
@@ -262,13 +231,27 @@ bool OctoBvh::refit(uint32_t c, int s) {
     mml = std::max(mml, minLevelOf(r));
   });
   cl.forEachSubCluster(s, [&](uint32_t sub) {
+    // note: no emptiness test: an empty node's bounds are inverted, its filter 0 and its max
+    // min level kEmptyMinLevel, so merging all 8 lanes is exact (and vectorises).
     const NodeCluster& ch = clusters_[sub];
-    for (int o = 0; o < 8; ++o) {
-      if (ch.isEmpty(o)) continue;
-      b.merge(ch.bounds(o));
-      filter |= ch.filter[o];
-      mml = std::max<int>(mml, ch.maxMinLevel[o]);
+    float lo[3] = {ch.minX[0], ch.minY[0], ch.minZ[0]}, hi[3] = {ch.maxX[0], ch.maxY[0], ch.maxZ[0]};
+    for (int o = 1; o < 8; ++o) {
+      lo[0] = std::min(lo[0], ch.minX[o]);
+      lo[1] = std::min(lo[1], ch.minY[o]);
+      lo[2] = std::min(lo[2], ch.minZ[o]);
+      hi[0] = std::max(hi[0], ch.maxX[o]);
+      hi[1] = std::max(hi[1], ch.maxY[o]);
+      hi[2] = std::max(hi[2], ch.maxZ[o]);
     }
+    uint32_t f = 0;
+    int m = kEmptyMinLevel;
+    for (int o = 0; o < 8; ++o) {
+      f |= ch.filter[o];
+      m = std::max<int>(m, ch.maxMinLevel[o]);
+    }
+    b.merge(Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
+    filter |= f;
+    mml = std::max(mml, m);
   });
   const bool changed = !(cl.bounds(s) == b) || cl.filter[s] != filter || cl.maxMinLevel[s] != mml;
   cl.setBounds(s, b);

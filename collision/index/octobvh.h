@@ -170,21 +170,55 @@ class OctoBvh {
   struct Cube {  // lattice cube of a node: origin (exact in double) and level
     double origin[3];
     int level;
-    int childSlotFor(const double c[3]) const;
-    Cube child(int slot) const;
+    // note: inline, as every level of every edit calls both.
+    int childSlotFor(const double c[3]) const {
+      const double half = octobvh::pow2(level - 1);
+      return (c[0] >= origin[0] + half ? 1 : 0) | (c[1] >= origin[1] + half ? 2 : 0) | (c[2] >= origin[2] + half ? 4 : 0);
+    }
+    Cube child(int slot) const {
+      const double half = octobvh::pow2(level - 1);
+      return {{origin[0] + ((slot & 1) ? half : 0.0), origin[1] + ((slot & 2) ? half : 0.0),
+               origin[2] + ((slot & 4) ? half : 0.0)},
+              level - 1};
+    }
   };
 
+  /// An element and where it goes, computed once per edit rather than at every level.
+  struct Placement {
+    uint32_t e;
+    int minLevel;
+    double ctr[3];
+  };
+  Placement placementOf(uint32_t e) const {
+    Placement p{e, octobvh::minLevelOf(elements_[e]), {}};
+    octobvh::centreOf(elements_[e], p.ctr);
+    return p;
+  }
   void validateElement(const Aabb& b, const char* context) const;
   void reserveHeadroom(const char* context) const;
-  Cube rootCube() const;
+  Cube rootCube() const {
+    const double o = -octobvh::pow2(rootLevel_ - 1);
+    return {{o, o, o}, rootLevel_};
+  }
   void growRootToHold(const double centre[3], int minLevel);
+  /// Whether element e keeps the root from shrinking (its centre outside the half-size root
+  /// cube or its min level too large for it): only removing such an element can let it shrink.
+  bool holdsRootUp(const Placement& p) const;
   void shrinkRoot();
   int canonicalRootLevel(const std::vector<uint32_t>& elems) const;
 
-  void insertAt(uint32_t c, int s, const Cube& cube, uint32_t e);
-  bool removeAt(uint32_t c, int s, const Cube& cube, uint32_t e);
-  void passDown(uint32_t sub, const Cube& cube, uint32_t e);
-  bool removeBelow(uint32_t sub, const Cube& cube, uint32_t e);
+  void insertAt(uint32_t c, int s, Cube cube, const Placement& p);
+  void removeAt(uint32_t c, int s, Cube cube, const Placement& p);
+  void passDown(uint32_t sub, const Cube& cube, const Placement& p);
+  bool updateInPlace(const Placement& old, const Placement& p, const octobvh::ElementRecord& moved);
+  /// The cluster an element of min level `minLevel` lives in below inner node (cl, s) of level
+  /// `level` (the children, or the node's forced cluster), or kInvalidIndex when the node holds
+  /// it: the placement rules, for walks that leave the structure as it is on the way down.
+  uint32_t clusterBelow(const NodeCluster& cl, int s, int level, int minLevel) const {
+    if (minLevel < level) return cl.child[s];
+    if (cl.numHeld[s] == octobvh::kForcedCluster) return cl.leaf[s];
+    return clusters_[cl.child[s]].forcedCount > 0 ? cl.child[s] : kInvalidIndex;
+  }
   void mergeIntoLeaf(uint32_t c, int s, uint32_t removed);
   void build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32_t count);
   void buildOctants(uint32_t sub, const Cube& cube, uint32_t* elems, uint32_t count);
@@ -196,9 +230,17 @@ class OctoBvh {
   uint32_t allocCluster(int level);
 
   // held-element lists (leaf blocks, or overflow chains at kMinLevel)
-  uint32_t heldCount(uint32_t c, int s) const;
+  uint32_t heldCount(uint32_t c, int s) const {
+    const NodeCluster& cl = clusters_[c];
+    if (cl.numHeld[s] == octobvh::kForcedCluster) return 0;
+    return cl.numHeld[s] == octobvh::kOverflow ? overflow_[cl.leaf[s]].count : cl.numHeld[s];
+  }
   /// Elements in the node's subtree: held, in its children and in its forced cluster.
-  uint32_t subtreeCount(uint32_t c, int s) const;
+  uint32_t subtreeCount(uint32_t c, int s) const {
+    uint32_t n = heldCount(c, s);
+    clusters_[c].forEachSubCluster(s, [&](uint32_t sub) { n += clusters_[sub].childTotal; });
+    return n;
+  }
   void heldAdd(uint32_t c, int s, uint32_t e);
   void heldRemove(uint32_t c, int s, uint32_t e);
   void heldTake(uint32_t c, int s, std::vector<uint32_t>& out);

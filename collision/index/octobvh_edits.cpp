@@ -24,10 +24,9 @@ uint32_t OctoBvh::insert(const Aabb& bounds, uint32_t filter, uint32_t payload) 
   }
   r.filter = filter;
   r.payload = payload;
-  double ctr[3];
-  centreOf(r, ctr);
-  growRootToHold(ctr, minLevelOf(r));
-  insertAt(rootCluster_, 0, rootCube(), e);
+  const Placement p = placementOf(e);
+  growRootToHold(p.ctr, p.minLevel);
+  insertAt(rootCluster_, 0, rootCube(), p);
   return e;
 }
 
@@ -90,78 +89,84 @@ void OctoBvh::growRootToHold(const double c[3], int minLevel) {
 
 // Passes e down into the node of cluster `sub` (the children or the forced cluster of the node
 // whose cube is `cube`) holding its centre.
-void OctoBvh::passDown(uint32_t sub, const Cube& cube, uint32_t e) {
+void OctoBvh::passDown(uint32_t sub, const Cube& cube, const Placement& p) {
   NodeCluster& to = clusters_[sub];
   ++to.childTotal;
   if (to.forcedCount) ++to.forcedCount;
-  double ctr[3];
-  centreOf(elements_[e], ctr);
-  const int o = cube.childSlotFor(ctr);
-  insertAt(sub, o, cube.child(o), e);
+  const int o = cube.childSlotFor(p.ctr);
+  insertAt(sub, o, cube.child(o), p);
 }
 
-void OctoBvh::insertAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
+// note: a loop, not passDown's recursion, on the way down: an insert walks ~15 levels and the
+// calls cost as much as the work at each (callgrind).
+void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
+  const uint32_t e = p.e;
   const ElementRecord& r = elements_[e];
-  const int m = minLevelOf(r);
-  {
+  const int m = p.minLevel;
+  for (;;) {
     NodeCluster& cl = clusters_[c];
-    Aabb b = cl.bounds(s);
-    b.merge(r.bounds());
-    cl.setBounds(s, b);
+    cl.minX[s] = std::min(cl.minX[s], r.min[0]);
+    cl.minY[s] = std::min(cl.minY[s], r.min[1]);
+    cl.minZ[s] = std::min(cl.minZ[s], r.min[2]);
+    cl.maxX[s] = std::max(cl.maxX[s], r.max[0]);
+    cl.maxY[s] = std::max(cl.maxY[s], r.max[1]);
+    cl.maxZ[s] = std::max(cl.maxZ[s], r.max[2]);
     cl.filter[s] |= r.filter;
     cl.maxMinLevel[s] = int8_t(std::max<int>(cl.maxMinLevel[s], m));
-  }
-  NodeCluster& cl = clusters_[c];
-  if (cl.child[s] == kInvalidIndex) {
-    if (cl.numHeld[s] < kLeafCapacity || cube.level == kMinLevel) {
-      heldAdd(c, s, e);
+    if (cl.child[s] == kInvalidIndex) {
+      if (cl.numHeld[s] < kLeafCapacity || cube.level == kMinLevel) {
+        heldAdd(c, s, e);
+        return;
+      }
+      // A leaf reaching 9 elements splits into the canonical subtree of those 9.
+      std::vector<uint32_t> nine;
+      nine.reserve(9);
+      heldTake(c, s, nine);
+      nine.push_back(e);
+      build(c, s, cube, nine.data(), uint32_t(nine.size()));
       return;
     }
-    // A leaf reaching 9 elements splits into the canonical subtree of those 9.
-    std::vector<uint32_t> nine;
-    nine.reserve(9);
-    heldTake(c, s, nine);
-    nine.push_back(e);
-    build(c, s, cube, nine.data(), uint32_t(nine.size()));
-    return;
-  }
-  const uint32_t child = cl.child[s];
-  if (m < cube.level) {
-    if (clusters_[child].forcedCount > 0) {
-      // The first element to fit a child under a node that forced everything it had: the forced
-      // subtree moves whole to the node's forced cluster, and new children take this element.
-      const uint32_t natural = allocCluster(cube.level - 1);
-      NodeCluster& n = clusters_[c];
-      n.leaf[s] = child;
-      n.numHeld[s] = kForcedCluster;
-      n.child[s] = natural;
+    const uint32_t child = cl.child[s];
+    uint32_t sub;  // the cluster e goes down into
+    if (m < cube.level) {
+      if (clusters_[child].forcedCount > 0) {
+        // The first element to fit a child under a node that forced everything it had: the
+        // forced subtree moves whole to the node's forced cluster, and new children take e.
+        const uint32_t natural = allocCluster(cube.level - 1);
+        NodeCluster& n = clusters_[c];
+        n.leaf[s] = child;
+        n.numHeld[s] = kForcedCluster;
+        n.child[s] = natural;
+      }
+      sub = clusters_[c].child[s];
+    } else if (cl.numHeld[s] == kForcedCluster) {
+      sub = cl.leaf[s];
+    } else if (clusters_[child].forcedCount > 0) {
+      sub = child;
+    } else if (cl.numHeld[s] < kLeafCapacity) {
+      heldAdd(c, s, e);
+      return;
+    } else {
+      // A 9th element too large for the children (some element fits them: the node is inner
+      // with only 8 held): the nine go to a new forced cluster by centre.
+      std::vector<uint32_t> big;
+      big.reserve(9);
+      heldTake(c, s, big);
+      big.push_back(e);
+      const uint32_t forced = allocCluster(cube.level - 1);
+      clusters_[c].leaf[s] = forced;
+      clusters_[c].numHeld[s] = kForcedCluster;
+      for (uint32_t x : big) passDown(forced, cube, placementOf(x));  // counts childTotal only while forcedCount is 0
+      clusters_[forced].forcedCount = uint32_t(big.size());
+      return;
     }
-    passDown(clusters_[c].child[s], cube, e);
-    return;
+    NodeCluster& to = clusters_[sub];
+    ++to.childTotal;
+    if (to.forcedCount) ++to.forcedCount;
+    s = cube.childSlotFor(p.ctr);
+    cube = cube.child(s);
+    c = sub;
   }
-  if (cl.numHeld[s] == kForcedCluster) {
-    passDown(cl.leaf[s], cube, e);
-    return;
-  }
-  if (clusters_[child].forcedCount > 0) {
-    passDown(child, cube, e);
-    return;
-  }
-  if (cl.numHeld[s] < kLeafCapacity) {
-    heldAdd(c, s, e);
-    return;
-  }
-  // A 9th element too large for the children (some element fits them: the node is inner with
-  // only 8 held): the nine go to a new forced cluster by centre.
-  std::vector<uint32_t> big;
-  big.reserve(9);
-  heldTake(c, s, big);
-  big.push_back(e);
-  const uint32_t forced = allocCluster(cube.level - 1);
-  clusters_[c].leaf[s] = forced;
-  clusters_[c].numHeld[s] = kForcedCluster;
-  for (uint32_t x : big) passDown(forced, cube, x);  // counts childTotal only while forcedCount is 0
-  clusters_[forced].forcedCount = uint32_t(big.size());
 }
 
 // ---------------------------------------------------------------- remove
@@ -169,9 +174,24 @@ void OctoBvh::insertAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
 void OctoBvh::remove(uint32_t handle) {
   if (!elements_.isLive(handle))
     throw InvalidInput("OctoBvh::remove: handle " + std::to_string(handle) + " is not an element of this tree");
-  removeAt(rootCluster_, 0, rootCube(), handle);
+  const Placement p = placementOf(handle);
+  const bool mayShrink = holdsRootUp(p);
+  removeAt(rootCluster_, 0, rootCube(), p);
   elements_.free(handle);
-  shrinkRoot();
+  if (mayShrink) shrinkRoot();
+}
+
+// The root shrinks when every element's centre lies in the half-size cube and every min level
+// fits it. The tree was canonical before the removal, so if e met both, another element that
+// does not is still there: only an element that held the root up can let it shrink.
+bool OctoBvh::holdsRootUp(const Placement& p) const {
+  const int R = rootLevel_ - 1;
+  if (R <= kMinLevel) return false;
+  if (p.minLevel > R - 1) return true;
+  const double half = pow2(R - 1);
+  for (double v : p.ctr)
+    if (!(v >= -half && v < half)) return true;
+  return false;
 }
 
 void OctoBvh::update(uint32_t handle, const Aabb& bounds, uint32_t filter) {
@@ -179,28 +199,58 @@ void OctoBvh::update(uint32_t handle, const Aabb& bounds, uint32_t filter) {
     throw InvalidInput("OctoBvh::update: handle " + std::to_string(handle) + " is not an element of this tree");
   validateElement(bounds, "OctoBvh::update");
   reserveHeadroom("OctoBvh::update");
-  removeAt(rootCluster_, 0, rootCube(), handle);
-  shrinkRoot();
-  ElementRecord& r = elements_[handle];
+  const Placement old = placementOf(handle);
+  ElementRecord moved = elements_[handle];
   for (int k = 0; k < 3; ++k) {
-    r.min[k] = bounds.min[k];
-    r.max[k] = bounds.max[k];
+    moved.min[k] = bounds.min[k];
+    moved.max[k] = bounds.max[k];
   }
-  r.filter = filter;
-  double ctr[3];
-  centreOf(r, ctr);
-  growRootToHold(ctr, minLevelOf(r));
-  insertAt(rootCluster_, 0, rootCube(), handle);
+  moved.filter = filter;
+  Placement p{handle, minLevelOf(moved), {}};
+  centreOf(moved, p.ctr);
+  if (p.minLevel == old.minLevel && !holdsRootUp(old) && !holdsRootUp(p) && updateInPlace(old, p, moved)) return;
+  const bool mayShrink = holdsRootUp(old);
+  removeAt(rootCluster_, 0, rootCube(), old);
+  if (mayShrink) shrinkRoot();
+  elements_[handle] = moved;
+  growRootToHold(p.ctr, p.minLevel);
+  insertAt(rootCluster_, 0, rootCube(), p);
 }
 
-bool OctoBvh::removeBelow(uint32_t sub, const Cube& cube, uint32_t e) {
-  NodeCluster& from = clusters_[sub];
-  --from.childTotal;
-  if (from.forcedCount) --from.forcedCount;
-  double ctr[3];
-  centreOf(elements_[e], ctr);
-  const int o = cube.childSlotFor(ctr);
-  return removeAt(sub, o, cube.child(o), e);
+// A small move usually leaves the element's centre in the cube of the node that holds it, with
+// the same min level: every placement decision is the same, so the canonical structure is too,
+// and only the summaries along the path change. One walk down (stopping if the new centre
+// leaves the old path), the record rewritten, then refits up while a summary changed: half
+// the work of a remove and an insert. Returns false, having changed nothing, when the path
+// differs (the caller then removes and inserts).
+bool OctoBvh::updateInPlace(const Placement& old, const Placement& p, const ElementRecord& moved) {
+  struct Step {
+    uint32_t c;
+    int s;
+  };
+  Step path[kMaxLevel - kMinLevel + 2];
+  int depth = 0;
+  uint32_t c = rootCluster_;
+  int s = 0;
+  Cube cube = rootCube();
+  for (;;) {
+    const NodeCluster& cl = clusters_[c];
+    path[depth++] = {c, s};
+    if (cl.child[s] == kInvalidIndex) break;  // a leaf: it holds the element
+    const uint32_t sub = clusterBelow(cl, s, cube.level, p.minLevel);
+    if (sub == kInvalidIndex) break;  // held at this inner node
+    const int o = cube.childSlotFor(old.ctr);
+    if (cube.childSlotFor(p.ctr) != o) return false;
+    c = sub;
+    s = o;
+    cube = cube.child(o);
+  }
+  elements_[p.e] = moved;
+  while (depth > 0) {
+    const Step st = path[--depth];
+    if (!refit(st.c, st.s)) break;
+  }
+  return true;
 }
 
 // The node becomes one leaf holding what is left of its subtree once `removed` is gone.
@@ -224,54 +274,72 @@ void OctoBvh::mergeIntoLeaf(uint32_t c, int s, uint32_t removed) {
   for (uint32_t x : rest) heldAdd(c, s, x);
 }
 
-// Returns whether the node's summary (bounds, filter OR, max min level) changed, so callers
-// above can skip their refit when it did not (most removals change only the bottom levels).
-bool OctoBvh::removeAt(uint32_t c, int s, const Cube& cube, uint32_t e) {
-  NodeCluster& cl = clusters_[c];
-  if (cl.child[s] == kInvalidIndex) {
-    heldRemove(c, s, e);
-    return refit(c, s);
+// Down the element's path (counts drop on the way), then back up: each node undoes a forced
+// split the removal ended and refits only while the summary below it changed (most removals
+// change only the bottom levels). An explicit path instead of recursion, as in insertAt.
+void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
+  enum Way : uint8_t { kToChildren, kToForcedCluster };
+  struct Step {
+    uint32_t c;
+    int s;
+    Way way;
+  };
+  Step path[kMaxLevel - kMinLevel + 2];  // every step goes down one level
+  int depth = 0;
+  const uint32_t e = p.e;
+  for (;;) {
+    NodeCluster& cl = clusters_[c];
+    if (cl.child[s] == kInvalidIndex) {
+      heldRemove(c, s, e);
+      break;
+    }
+    if (subtreeCount(c, s) - 1 <= uint32_t(kLeafCapacity)) {
+      mergeIntoLeaf(c, s, e);
+      break;
+    }
+    // (Under a node that forced everything, more than 8 are left: else it merged above.)
+    const uint32_t sub = clusterBelow(cl, s, cube.level, p.minLevel);
+    if (sub == kInvalidIndex) {
+      heldRemove(c, s, e);
+      break;
+    }
+    path[depth++] = {c, s, sub == cl.child[s] ? kToChildren : kToForcedCluster};
+    NodeCluster& from = clusters_[sub];
+    --from.childTotal;
+    if (from.forcedCount) --from.forcedCount;
+    s = cube.childSlotFor(p.ctr);
+    cube = cube.child(s);
+    c = sub;
   }
-  if (subtreeCount(c, s) - 1 <= uint32_t(kLeafCapacity)) {
-    mergeIntoLeaf(c, s, e);
-    return refit(c, s);
-  }
-  const uint32_t child = cl.child[s];
-  const uint32_t forced = cl.forced(s);
-  const int m = minLevelOf(elements_[e]);
-  bool below = true;  // whether something below may have changed this node's summary
-  if (m < cube.level) {
-    below = removeBelow(child, cube, e);
-    if (forced != kInvalidIndex && clusters_[child].childTotal == 0) {
+  bool changed = refit(c, s);
+  while (depth > 0) {
+    const Step st = path[--depth];
+    NodeCluster& cl = clusters_[st.c];
+    const uint32_t child = cl.child[st.s], forced = cl.forced(st.s);
+    if (st.way == kToChildren && forced != kInvalidIndex && clusters_[child].childTotal == 0) {
       // Nothing left that fits a child: the forced subtree becomes the children again.
       clusters_.free(child);
-      NodeCluster& n = clusters_[c];
-      n.child[s] = forced;
-      n.numHeld[s] = 0;
-      n.leaf[s] = kInvalidIndex;
-      below = true;
-    }
-  } else if (forced != kInvalidIndex) {
-    below = removeBelow(forced, cube, e);
-    if (clusters_[forced].childTotal == uint32_t(kLeafCapacity)) {
+      NodeCluster& n = clusters_[st.c];
+      n.child[st.s] = forced;
+      n.numHeld[st.s] = 0;
+      n.leaf[st.s] = kInvalidIndex;
+      changed = true;
+    } else if (st.way == kToForcedCluster && clusters_[forced].childTotal == uint32_t(kLeafCapacity)) {
       // Down to 8 large elements: they are held here again.
       std::vector<uint32_t> big;
       big.reserve(8);
       for (int o = 0; o < 8; ++o)
         if (!clusters_[forced].isEmpty(o)) gatherSubtree(forced, o, big);
-      NodeCluster& n = clusters_[c];
-      n.numHeld[s] = 0;
-      n.leaf[s] = kInvalidIndex;
+      NodeCluster& n = clusters_[st.c];
+      n.numHeld[st.s] = 0;
+      n.leaf[st.s] = kInvalidIndex;
       freeSubtreeClusters(forced);
-      for (uint32_t x : big) heldAdd(c, s, x);
-      below = true;
+      for (uint32_t x : big) heldAdd(st.c, st.s, x);
+      changed = true;
     }
-  } else if (clusters_[child].forcedCount > 0) {
-    below = removeBelow(child, cube, e);  // stays forced: more than 8 are left (else merged above)
-  } else {
-    heldRemove(c, s, e);
+    if (!changed) continue;
+    changed = refit(st.c, st.s);
   }
-  return below ? refit(c, s) : false;
 }
 
 void OctoBvh::shrinkRoot() {

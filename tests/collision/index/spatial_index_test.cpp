@@ -306,6 +306,45 @@ TEST(OctoBvh, RandomEditSequencesMatchFreshBuild) {
   }
 }
 
+// Small moves and resizes mostly keep an element's centre in the cube of the node holding it,
+// which update() absorbs in place (summaries refitted along the path, no remove and insert):
+// the tree must stay exactly the canonical one, with tight bounds and filter ORs.
+TEST(OctoBvh, SmallMovesAndResizesKeepTheTreeCanonical) {
+  for (const Vec3f& offset : {Vec3f(0, 0, 0), Vec3f(4e5f, -2e5f, 9e5f)}) {
+    SeededRandom r(offset.x() == 0 ? 41 : 42);
+    const std::vector<Aabb> boxes = mixedWorkload(3000, 7, offset);
+    OctoBvh tree;
+    test::BruteForceIndex ref;
+    std::vector<uint32_t> live;
+    for (uint32_t i = 0; i < boxes.size(); ++i) {
+      const uint32_t h = tree.insert(boxes[i], filterFor(i), i);
+      ref.items[h] = {boxes[i], filterFor(i)};
+      live.push_back(h);
+    }
+    Aabb region = Aabb::empty();
+    for (const Aabb& b : boxes) region.merge(b);
+    for (int step = 0; step < 4000; ++step) {
+      const uint32_t h = live[r.below(uint32_t(live.size()))];
+      const Aabb b = tree.bounds(h);
+      const Vec3f half = b.extent() * 0.5f;
+      // Up to a third of the element's size, sometimes a resize by up to 10%, sometimes new filter bits.
+      const Vec3f d(float(r.uniform(-0.3, 0.3)) * b.extent().x(), float(r.uniform(-0.3, 0.3)) * b.extent().y(),
+                    float(r.uniform(-0.3, 0.3)) * b.extent().z());
+      const float scale = step % 3 == 0 ? float(r.uniform(0.9, 1.1)) : 1.f;
+      const Vec3f c = b.center() + d;
+      const Aabb moved{c - half * scale, c + half * scale};
+      const uint32_t filter = step % 5 == 0 ? filterFor(uint32_t(step)) : ref.items[h].filter;
+      tree.update(h, moved, filter);
+      ref.items[h] = {moved, filter};
+      if (step % 500 == 499) {
+        tree.validate();
+        ASSERT_EQ(tree.structureHash(), freshBuildHash(tree)) << "step " << step;
+        expectQueriesMatch(tree, ref, r, 40, region);
+      }
+    }
+  }
+}
+
 TEST(OctoBvh, PlateStackForceSplitsAndUndoesThem) {
   const std::vector<Aabb> plates = generatePlateStack(300, 200.f, 4);
   OctoBvh tree;
