@@ -243,6 +243,7 @@ class OctoBvh {
   }
   void heldAdd(uint32_t c, int s, uint32_t e);
   void heldRemove(uint32_t c, int s, uint32_t e);
+  bool heldRemoveChanges(uint32_t c, int s, const Placement& p);
   void heldTake(uint32_t c, int s, std::vector<uint32_t>& out);
   template <class F>
   void forEachHeld(const NodeCluster& cl, int s, F&& f) const;

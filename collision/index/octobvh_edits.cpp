@@ -127,6 +127,7 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
       return;
     }
     const uint32_t child = cl.child[s];
+    prefetchForEdit(clusters_[child], true);
     uint32_t sub;  // the cluster e goes down into
     if (m < cube.level) {
       if (clusters_[child].forcedCount > 0) {
@@ -237,6 +238,7 @@ bool OctoBvh::updateInPlace(const Placement& old, const Placement& p, const Elem
     const NodeCluster& cl = clusters_[c];
     path[depth++] = {c, s};
     if (cl.child[s] == kInvalidIndex) break;  // a leaf: it holds the element
+    prefetchForEdit(clusters_[cl.child[s]], false);
     const uint32_t sub = clusterBelow(cl, s, cube.level, p.minLevel);
     if (sub == kInvalidIndex) break;  // held at this inner node
     const int o = cube.childSlotFor(old.ctr);
@@ -274,6 +276,24 @@ void OctoBvh::mergeIntoLeaf(uint32_t c, int s, uint32_t removed) {
   for (uint32_t x : rest) heldAdd(c, s, x);
 }
 
+// Takes e out of the elements node (c, s) holds and says whether the node's summary may have
+// changed. It cannot when e lay strictly inside the node's bounds, below its largest min
+// level, and a remaining held element has all of e's filter bits: then one record is read
+// instead of every remaining one (a refit), and nothing above is refitted either.
+bool OctoBvh::heldRemoveChanges(uint32_t c, int s, const Placement& p) {
+  heldRemove(c, s, p.e);
+  const NodeCluster& cl = clusters_[c];
+  const ElementRecord& r = elements_[p.e];
+  if (cl.numHeld[s] == 0 || p.minLevel >= cl.maxMinLevel[s]) return true;
+  if (!(r.min[0] > cl.minX[s] && r.min[1] > cl.minY[s] && r.min[2] > cl.minZ[s] && r.max[0] < cl.maxX[s] &&
+        r.max[1] < cl.maxY[s] && r.max[2] < cl.maxZ[s]))
+    return true;
+  uint32_t other = cl.leaf[s];  // a single held element is inline
+  if (cl.numHeld[s] == kOverflow) other = overflow_[cl.leaf[s]].elements[0];
+  else if (cl.numHeld[s] > 1) other = leaves_[cl.leaf[s]].elements[0];
+  return (r.filter & ~elements_[other].filter) != 0;
+}
+
 // Down the element's path (counts drop on the way), then back up: each node undoes a forced
 // split the removal ended and refits only while the summary below it changed (most removals
 // change only the bottom levels). An explicit path instead of recursion, as in insertAt.
@@ -287,12 +307,14 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
   Step path[kMaxLevel - kMinLevel + 2];  // every step goes down one level
   int depth = 0;
   const uint32_t e = p.e;
+  bool changed = true;  // whether the summary of the node the walk stopped at changed
   for (;;) {
     NodeCluster& cl = clusters_[c];
     if (cl.child[s] == kInvalidIndex) {
-      heldRemove(c, s, e);
+      changed = heldRemoveChanges(c, s, p);
       break;
     }
+    prefetchForEdit(clusters_[cl.child[s]], false);
     if (subtreeCount(c, s) - 1 <= uint32_t(kLeafCapacity)) {
       mergeIntoLeaf(c, s, e);
       break;
@@ -300,7 +322,7 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
     // (Under a node that forced everything, more than 8 are left: else it merged above.)
     const uint32_t sub = clusterBelow(cl, s, cube.level, p.minLevel);
     if (sub == kInvalidIndex) {
-      heldRemove(c, s, e);
+      changed = heldRemoveChanges(c, s, p);
       break;
     }
     path[depth++] = {c, s, sub == cl.child[s] ? kToChildren : kToForcedCluster};
@@ -311,7 +333,7 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
     cube = cube.child(s);
     c = sub;
   }
-  bool changed = refit(c, s);
+  if (changed) changed = refit(c, s);
   while (depth > 0) {
     const Step st = path[--depth];
     NodeCluster& cl = clusters_[st.c];
