@@ -191,9 +191,13 @@ void OctoBvh::heldRemove(uint32_t c, int s, uint32_t e) {
 }
 
 void OctoBvh::heldTake(uint32_t c, int s, std::vector<uint32_t>& out) {
+  forEachHeld(clusters_[c], s, [&](uint32_t e) { out.push_back(e); });
+  heldDrop(c, s);
+}
+
+void OctoBvh::heldDrop(uint32_t c, int s) {
   NodeCluster& cl = clusters_[c];
   BW_ASSERT(cl.numHeld[s] != kForcedCluster);
-  forEachHeld(cl, s, [&](uint32_t e) { out.push_back(e); });
   if (cl.numHeld[s] == kOverflow) {
     for (uint32_t b = cl.leaf[s]; b != kInvalidIndex;) {
       const uint32_t next = overflow_[b].next;
@@ -275,7 +279,6 @@ void OctoBvh::gatherSubtree(uint32_t cluster, int s, std::vector<uint32_t>& out)
 }
 
 void OctoBvh::freeSubtreeClusters(uint32_t cluster) {
-  std::vector<uint32_t> dropped;
   for (int o = 0; o < 8; ++o) {
     NodeCluster& cl = clusters_[cluster];
     if (cl.numHeld[o] == kForcedCluster) {
@@ -285,8 +288,7 @@ void OctoBvh::freeSubtreeClusters(uint32_t cluster) {
       freeSubtreeClusters(forced);
     }
     if (clusters_[cluster].child[o] != kInvalidIndex) freeSubtreeClusters(clusters_[cluster].child[o]);
-    dropped.clear();
-    heldTake(cluster, o, dropped);
+    heldDrop(cluster, o);
   }
   clusters_.free(cluster);
 }
@@ -358,7 +360,7 @@ int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {
     double ctr[3];
     centreOf(r, ctr);
     for (double v : ctr)
-      while (!(v >= -std::ldexp(1.0, R) && v < std::ldexp(1.0, R))) ++R;
+      while (!(v >= -pow2(R) && v < pow2(R))) ++R;
   }
   return R + 1;
 }

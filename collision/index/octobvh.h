@@ -245,6 +245,8 @@ class OctoBvh {
   void heldRemove(uint32_t c, int s, uint32_t e);
   bool heldRemoveChanges(uint32_t c, int s, const Placement& p);
   void heldTake(uint32_t c, int s, std::vector<uint32_t>& out);
+  /// Empties the node's held list, freeing its blocks (the elements stay in the pool).
+  void heldDrop(uint32_t c, int s);
   template <class F>
   void forEachHeld(const NodeCluster& cl, int s, F&& f) const;
   template <class OnElement, class Accept>
@@ -261,6 +263,7 @@ class OctoBvh {
   VirtualPool<octobvh::OverflowBlock> overflow_;
   uint32_t rootCluster_ = kInvalidIndex;  ///< slot 0 is the root node
   int rootLevel_ = octobvh::kMinLevel + 1;
+  std::vector<uint32_t> mergeScratch_;  ///< mergeIntoLeaf's (edits are exclusive): no allocation per merge
 };
 
 }  // namespace bw

@@ -257,8 +257,8 @@ bool OctoBvh::updateInPlace(const Placement& old, const Placement& p, const Elem
 
 // The node becomes one leaf holding what is left of its subtree once `removed` is gone.
 void OctoBvh::mergeIntoLeaf(uint32_t c, int s, uint32_t removed) {
-  std::vector<uint32_t> rest;
-  rest.reserve(9);
+  std::vector<uint32_t>& rest = mergeScratch_;
+  rest.clear();
   gatherSubtree(c, s, rest);
   rest.erase(std::find(rest.begin(), rest.end(), removed));
   NodeCluster& cl = clusters_[c];
@@ -269,8 +269,7 @@ void OctoBvh::mergeIntoLeaf(uint32_t c, int s, uint32_t removed) {
     cl.leaf[s] = kInvalidIndex;
     freeSubtreeClusters(forced);
   } else {
-    std::vector<uint32_t> held;
-    heldTake(c, s, held);
+    heldDrop(c, s);
   }
   freeSubtreeClusters(child);
   for (uint32_t x : rest) heldAdd(c, s, x);
