@@ -2,6 +2,7 @@
 /// cost; loose kD tree vs Bullet's btBvhTriangleMeshShape (quantized and not) on the same
 /// chunk meshes and on one ~1M-triangle heightfield, both sides in the same run; mesher and
 /// cached terrain raycasts. Figures are Google Benchmark counters.
+#include <BulletCollision/CollisionShapes/btHeightfieldTerrainShape.h>
 #include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
 #include <benchmark/benchmark.h>
 #include <btBulletCollisionCommon.h>
@@ -119,6 +120,27 @@ struct BulletClosestHit : btTriangleRaycastCallback {
   }
 };
 
+/// The same heights as Bullet holds a heightfield: btHeightfieldTerrainShape (float heights,
+/// quads cut along the same diagonal: flipQuadEdges) with its ray accelerator (buildAccelerator:
+/// min/max heights per 16 x 16 chunk, walked along the ray), the setup its docs advise for
+/// raycasts on large heightfields. Its local origin is the middle of its bounds.
+struct BulletHeightfield {
+  std::vector<float> heights;  // (n + 1)^2, row by row along x
+  std::unique_ptr<btHeightfieldTerrainShape> shape;
+  btVector3 origin;  // where the shape's local origin lies in the mesh's frame
+  BulletHeightfield(const std::vector<Vec3f>& vertices, uint32_t n) {
+    float lo = vertices[0].y(), hi = lo;
+    for (const Vec3f& v : vertices) {
+      heights.push_back(v.y());
+      lo = std::min(lo, v.y());
+      hi = std::max(hi, v.y());
+    }
+    shape = std::make_unique<btHeightfieldTerrainShape>(int(n + 1), int(n + 1), heights.data(), lo, hi, 1, true);
+    shape->buildAccelerator();
+    origin = btVector3(float(n) * 0.5f, (lo + hi) * 0.5f, float(n) * 0.5f);  // spacing 1
+  }
+};
+
 struct BulletCountTriangles : btTriangleCallback {
   uint64_t count = 0;
   void processTriangle(btVector3*, int, int) override { ++count; }
@@ -132,7 +154,8 @@ struct RaySample {
 btVector3 bt(const Vec3f& v) { return btVector3(v.x(), v.y(), v.z()); }
 
 // KdTreeNoHeightBounds: the same tree built without height bounds (what they bring, measured).
-enum Side { kKdTree = 0, kBtQuantized = 1, kBtNonQuantized = 2, kKdTreeNoHeightBounds = 3 };
+// btHeightfield: Bullet's heightfield shape over the same heights (BulletHeightfield).
+enum Side { kKdTree = 0, kBtQuantized = 1, kBtNonQuantized = 2, kKdTreeNoHeightBounds = 3, kBtHeightfield = 4 };
 
 // ---------------------------------------------------------------------------------------------
 // Bitmask broadphase
@@ -324,9 +347,10 @@ void BM_Heightfield1M_Build(benchmark::State& state, int side) {
 struct HeightfieldSides {
   LooseKdTree kd, kdPlain;  // with height bounds (the heightfield is wide) and without
   std::unique_ptr<BulletBvhMesh> q, nq;
+  std::unique_ptr<BulletHeightfield> hf;
   std::vector<RaySample> rays;
   std::vector<Aabb> boxes;
-  uint32_t disagreements = 0;
+  uint32_t disagreements = 0, heightfieldDisagreements = 0;
 };
 const HeightfieldSides& heightfieldSides() {
   static const HeightfieldSides s = [] {
@@ -337,6 +361,7 @@ const HeightfieldSides& heightfieldSides() {
     s.kdPlain.build(hf.view(), b, KdHeightBoundsMode::Off);
     s.q = std::make_unique<BulletBvhMesh>(hf.view(), true);
     s.nq = std::make_unique<BulletBvhMesh>(hf.view(), false);
+    s.hf = std::make_unique<BulletHeightfield>(hf.vertices, kHeightfieldQuads);
     std::mt19937 rng(13);
     std::uniform_real_distribution<float> xz(5.f, float(kHeightfieldQuads) - 5.f), up(2.f, 30.f), sl(-0.6f, 0.6f);
     for (int i = 0; i < 4096; ++i) {
@@ -352,6 +377,10 @@ const HeightfieldSides& heightfieldSides() {
       BulletClosestHit cb(bt(r.origin), bt(r.origin + r.dir * r.length));
       s.q->shape->performRaycast(&cb, cb.m_from, cb.m_to);
       if (kd != (cb.triangle >= 0) || (kd && int(h.triangle) != cb.triangle)) ++s.disagreements;
+      // The heightfield numbers its triangles its own way: compare where the hit lies.
+      BulletClosestHit hcb(bt(r.origin) - s.hf->origin, bt(r.origin + r.dir * r.length) - s.hf->origin);
+      s.hf->shape->performRaycast(&hcb, hcb.m_from, hcb.m_to);
+      if (kd != (hcb.triangle >= 0) || (kd && std::abs(hcb.m_hitFraction * r.length - h.t) > 1e-3f)) ++s.heightfieldDisagreements;
     }
     return s;
   }();
@@ -367,6 +396,10 @@ void BM_Heightfield1M_Raycast(benchmark::State& state, int side) {
     if (side == kKdTree || side == kKdTreeNoHeightBounds) {
       KdRayHit h;
       hits += (side == kKdTree ? s.kd : s.kdPlain).raycastClosest(v, Ray::make(r.origin, r.dir, r.length), h);
+    } else if (side == kBtHeightfield) {
+      BulletClosestHit cb(bt(r.origin) - s.hf->origin, bt(r.origin + r.dir * r.length) - s.hf->origin);
+      s.hf->shape->performRaycast(&cb, cb.m_from, cb.m_to);
+      hits += cb.triangle >= 0;
     } else {
       BulletClosestHit cb(bt(r.origin), bt(r.origin + r.dir * r.length));
       (side == kBtQuantized ? s.q : s.nq)->shape->performRaycast(&cb, cb.m_from, cb.m_to);
@@ -374,7 +407,8 @@ void BM_Heightfield1M_Raycast(benchmark::State& state, int side) {
     }
   }
   state.counters["hit_fraction"] = double(hits) / double(state.iterations());
-  state.counters["closest_hit_disagreements"] = double(s.disagreements);
+  state.counters["closest_hit_disagreements"] =
+      double(side == kBtHeightfield ? s.heightfieldDisagreements : s.disagreements);
   if (side == kKdTree || side == kKdTreeNoHeightBounds) {
     // Nodes visited per ray over the 4096 rays, counted outside the timed loop.
     uint64_t visited = 0;
@@ -451,6 +485,7 @@ BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, KdTree, kKdTree);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, KdTreeNoHeightBounds, kKdTreeNoHeightBounds);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, btBvhQuantized, kBtQuantized);
 BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, btBvhNonQuantized, kBtNonQuantized);
+BENCHMARK_CAPTURE(BM_Heightfield1M_Raycast, btHeightfield, kBtHeightfield);
 BENCHMARK_CAPTURE(BM_Heightfield1M_AabbQuery2m, KdTree, kKdTree);
 BENCHMARK_CAPTURE(BM_Heightfield1M_AabbQuery2m, btBvhQuantized, kBtQuantized);
 BENCHMARK_CAPTURE(BM_Heightfield1M_AabbQuery2m, btBvhNonQuantized, kBtNonQuantized);
