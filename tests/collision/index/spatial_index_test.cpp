@@ -37,6 +37,25 @@ std::vector<Aabb> mixedWorkload(uint32_t count, uint64_t seed, Vec3f offset) {
 
 uint32_t filterFor(uint32_t i) { return 1u << (i % 3); }
 
+/// Inserts every box (payload: its position) into the index and the brute-force reference;
+/// returns the handles.
+template <class Index>
+std::vector<uint32_t> insertMirrored(Index& index, test::BruteForceIndex& ref, const std::vector<Aabb>& boxes) {
+  std::vector<uint32_t> live;
+  for (uint32_t i = 0; i < boxes.size(); ++i) {
+    const uint32_t h = index.insert(boxes[i], filterFor(i), i);
+    ref.items[h] = {boxes[i], filterFor(i)};
+    live.push_back(h);
+  }
+  return live;
+}
+
+Aabb regionOf(const std::vector<Aabb>& boxes) {
+  Aabb region = Aabb::empty();
+  for (const Aabb& b : boxes) region.merge(b);
+  return region;
+}
+
 template <class Index>
 void expectQueriesMatch(const Index& index, const test::BruteForceIndex& ref, SeededRandom& r, int queries,
                         const Aabb& region) {
@@ -105,14 +124,8 @@ TYPED_TEST(SpatialIndexTest, QueriesMatchBruteForceAfterRandomEdits) {
     const std::vector<Aabb> boxes = mixedWorkload(6000, 5, offset);
     TypeParam index;
     test::BruteForceIndex ref;
-    std::vector<uint32_t> live;
-    for (uint32_t i = 0; i < boxes.size(); ++i) {
-      const uint32_t h = index.insert(boxes[i], filterFor(i), i);
-      ref.items[h] = {boxes[i], filterFor(i)};
-      live.push_back(h);
-    }
-    Aabb region = Aabb::empty();
-    for (const Aabb& b : boxes) region.merge(b);
+    std::vector<uint32_t> live = insertMirrored(index, ref, boxes);
+    const Aabb region = regionOf(boxes);
     expectQueriesMatch(index, ref, r, 150, region);
     // Remove a third, move a third, add some back.
     for (int k = 0; k < 2000; ++k) {
@@ -315,14 +328,8 @@ TEST(OctoBvh, SmallMovesAndResizesKeepTheTreeCanonical) {
     const std::vector<Aabb> boxes = mixedWorkload(3000, 7, offset);
     OctoBvh tree;
     test::BruteForceIndex ref;
-    std::vector<uint32_t> live;
-    for (uint32_t i = 0; i < boxes.size(); ++i) {
-      const uint32_t h = tree.insert(boxes[i], filterFor(i), i);
-      ref.items[h] = {boxes[i], filterFor(i)};
-      live.push_back(h);
-    }
-    Aabb region = Aabb::empty();
-    for (const Aabb& b : boxes) region.merge(b);
+    std::vector<uint32_t> live = insertMirrored(tree, ref, boxes);
+    const Aabb region = regionOf(boxes);
     for (int step = 0; step < 4000; ++step) {
       const uint32_t h = live[r.below(uint32_t(live.size()))];
       const Aabb b = tree.bounds(h);
