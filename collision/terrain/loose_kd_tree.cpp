@@ -97,20 +97,22 @@ void LooseKdTree::quantiseHeights(KdTreeBuilder& b) {
   // note: 65534 steps over the range, so code 65535 lies a whole step above the top: more than
   // any rounding of base + q * step when the range is not tiny against the base.
   heightStep_ = range > 0.f ? range / 65534.f : 1.f;
+  auto noBounds = [&] {
+    heights_.clear();
+    heightAxis_ = -1;
+  };
+  if (!std::isfinite(heightBase_) || !std::isfinite(range)) return noBounds();
   heights_.resize(nodes_.size());
   for (size_t i = 0; i < nodes_.size(); ++i) {
     const float lo = b.heightLo[i], hi = b.heightHi[i];
+    if (!(lo >= heightBase_ && hi <= bounds_.max[a])) return noBounds();  // NaN vertices: no bounds
     float qlo = std::floor((lo - heightBase_) / heightStep_), qhi = std::ceil((hi - heightBase_) / heightStep_);
     uint16_t dlo = uint16_t(std::clamp(qlo, 0.f, 65535.f)), dhi = uint16_t(std::clamp(qhi, 0.f, 65535.f));
     // Rounded outwards as the query will dequantise them, whatever the division's rounding did.
     while (dlo > 0 && heightOf(dlo) > lo) --dlo;
     while (dhi < 65535 && heightOf(dhi) < hi) ++dhi;
-    if (heightOf(dlo) > lo || heightOf(dhi) < hi) {
-      // A range too small against its base to code in 16 bits (far from the origin): no bounds.
-      heights_.clear();
-      heightAxis_ = -1;
-      return;
-    }
+    // A range too small against its base to code in 16 bits (far from the origin): no bounds.
+    if (heightOf(dlo) > lo || heightOf(dhi) < hi) return noBounds();
     heights_[i] = {dlo, dhi};
   }
 }
