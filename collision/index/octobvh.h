@@ -29,6 +29,7 @@
 /// InvalidInput and a full pool throws CapacityExceeded, both before anything is modified.
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "collision/core/assert.h"
@@ -69,6 +70,10 @@ class OctoBvh {
   uint32_t insert(const Aabb& bounds, uint32_t filter, uint32_t payload);
   /// Removes an element by handle.
   void remove(uint32_t handle);
+  /// Removes many elements at once (live, distinct handles; InvalidInput otherwise, before
+  /// anything changes): the same tree as removing them one by one, in one walk down their
+  /// paths that frees whole subtrees and refits each node once.
+  void removeMany(std::span<const uint32_t> handles);
   /// Moves/resizes an element and changes its filter bits; the handle stays.
   void update(uint32_t handle, const Aabb& bounds, uint32_t filter);
   /// Builds the tree of the given elements in one pass (same structure as inserting them one
@@ -220,9 +225,26 @@ class OctoBvh {
     return clusters_[cl.child[s]].forcedCount > 0 ? cl.child[s] : kInvalidIndex;
   }
   void mergeIntoLeaf(uint32_t c, int s, uint32_t removed);
-  void build(uint32_t c, int s, const Cube& cube, uint32_t* elems, uint32_t count);
-  void buildOctants(uint32_t sub, const Cube& cube, uint32_t* elems, uint32_t count);
-  void makeLeaf(uint32_t c, int s, const uint32_t* elems, uint32_t count);
+  /// Frees everything at and below node (c, s) and makes it a leaf holding `rest` (not refitted).
+  void replaceWithLeaf(uint32_t c, int s, const std::vector<uint32_t>& rest);
+  /// An element as a build sorts it: its centre and min level, computed once.
+  struct BuildItem {
+    double ctr[3];
+    uint32_t e;
+    int8_t minLevel;
+    uint8_t slot;  ///< the child cube holding the centre, at the level being partitioned
+  };
+  /// The canonical subtree of the given elements at the (empty) node (c, s).
+  void buildFrom(uint32_t c, int s, const Cube& cube, const uint32_t* elems, uint32_t count);
+  void build(uint32_t c, int s, const Cube& cube, BuildItem* items, uint32_t count);
+  void buildOctants(uint32_t sub, const Cube& cube, BuildItem* items, uint32_t count);
+  /// Sorts the items by the child cube of `cube` holding their centres (counts and starts per
+  /// octant), in place; the order within an octant is the build's (leaves keep it).
+  static void partitionByOctant(const Cube& cube, BuildItem* items, uint32_t n, uint32_t start[8], uint32_t counts[8]);
+  void removeManyAt(uint32_t c, int s, const Cube& cube, BuildItem* items, uint32_t k);
+  /// Frees a big build's items (32 B per element built) once done; small ones (a leaf split on
+  /// insert) keep theirs, so edits do not allocate.
+  void releaseBuildScratch();
   void gatherSubtree(uint32_t c, int s, std::vector<uint32_t>& out) const;
   void freeSubtreeClusters(uint32_t cluster);
   bool refit(uint32_t c, int s);
@@ -264,6 +286,8 @@ class OctoBvh {
   uint32_t rootCluster_ = kInvalidIndex;  ///< slot 0 is the root node
   int rootLevel_ = octobvh::kMinLevel + 1;
   std::vector<uint32_t> mergeScratch_;  ///< mergeIntoLeaf's (edits are exclusive): no allocation per merge
+  std::vector<BuildItem> buildScratch_; ///< buildFrom's and removeMany's items (kept when small)
+  const uint8_t* removing_ = nullptr;   ///< during removeMany: by handle, 1 for those it takes
 };
 
 }  // namespace bw

@@ -54,7 +54,7 @@ void OctoBvh::growRootToHold(const double c[3], int minLevel) {
           heldTake(oldC, o, many);
           const double no = -std::ldexp(1.0, R + 1);
           const Cube newRootCube{{no, no, no}, R + 2};
-          build(newC, o, newRootCube.child(o), many.data(), uint32_t(many.size()));
+          buildFrom(newC, o, newRootCube.child(o), many.data(), uint32_t(many.size()));
         } else if (old.child[o] == kInvalidIndex) {
           nc.setBounds(o, old.bounds(o));
           nc.leaf[o] = old.leaf[o];
@@ -123,7 +123,7 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
       nine.reserve(9);
       heldTake(c, s, nine);
       nine.push_back(e);
-      build(c, s, cube, nine.data(), uint32_t(nine.size()));
+      buildFrom(c, s, cube, nine.data(), uint32_t(nine.size()));
       return;
     }
     const uint32_t child = cl.child[s];
@@ -261,6 +261,10 @@ void OctoBvh::mergeIntoLeaf(uint32_t c, int s, uint32_t removed) {
   rest.clear();
   gatherSubtree(c, s, rest);
   rest.erase(std::find(rest.begin(), rest.end(), removed));
+  replaceWithLeaf(c, s, rest);
+}
+
+void OctoBvh::replaceWithLeaf(uint32_t c, int s, const std::vector<uint32_t>& rest) {
   NodeCluster& cl = clusters_[c];
   const uint32_t child = cl.child[s], forced = cl.forced(s);
   cl.child[s] = kInvalidIndex;
@@ -271,7 +275,7 @@ void OctoBvh::mergeIntoLeaf(uint32_t c, int s, uint32_t removed) {
   } else {
     heldDrop(c, s);
   }
-  freeSubtreeClusters(child);
+  if (child != kInvalidIndex) freeSubtreeClusters(child);
   for (uint32_t x : rest) heldAdd(c, s, x);
 }
 

@@ -1,6 +1,6 @@
 // Fuzz target: OctoBVH edit sequences against a brute-force oracle. The bytes are a program of
-// inserts, removes, updates (some of them bad: NaN, inverted, out of range, unknown handles,
-// a full tree) and queries (box, oriented box, closest and all hits along a ray), each answer
+// inserts, removes, updates, bulk removals (some of them bad: NaN, inverted, out of range,
+// unknown or repeated handles, a full tree) and queries (box, oriented box, closest and all hits along a ray), each answer
 // compared with a scan of every element. A refused edit must leave the structure hash as it
 // was; at the end the tree validates and hashes equal to a fresh bulk load of its elements.
 #include <algorithm>
@@ -78,6 +78,40 @@ void removeOrUpdate(FuzzInput& in, OctoBvh& tree, Oracle& o, float anchor, bool 
     FUZZ_CHECK(!live || (update && !fuzz::acceptableBox(b)), "refused a good edit of handle %u", h);
     FUZZ_CHECK(tree.structureHash() == before, "a refused edit changed the tree");
   }
+}
+
+// Many elements out at once (removeMany): a random subset or everything on one side of a plane
+// (a part breaking off), sometimes with a handle listed twice or a dead one (refused whole).
+void removeMany(FuzzInput& in, OctoBvh& tree, Oracle& o) {
+  std::vector<uint32_t> gone;
+  const int axis = int(in.below(3));
+  const bool plane = in.below(2) == 0;
+  const float cut = float(in.below(256)) / 255.f;
+  const Aabb all = o.index.items.empty() ? Aabb{} : tree.rootBounds();
+  const float at = all.min[axis] + cut * (all.max[axis] - all.min[axis]);
+  for (const auto& [h, item] : o.index.items)
+    if (plane ? item.bounds.center()[axis] < at : in.below(4) != 0) gone.push_back(h);
+  const uint32_t bad = in.below(8);
+  if (bad == 0 && !gone.empty()) gone.push_back(gone[in.below(uint32_t(gone.size()))]);
+  if (bad == 1) gone.push_back(in.u16() + kCapacity);  // never a live handle
+  if (bad <= 1 && !gone.empty()) {
+    const uint64_t before = tree.structureHash();
+    bool refused = false;
+    try {
+      tree.removeMany(gone);
+    } catch (const InvalidInput&) {
+      refused = true;
+    }
+    FUZZ_CHECK(refused, "removeMany accepted a bad list of %zu handles", gone.size());
+    FUZZ_CHECK(tree.structureHash() == before, "a refused removeMany changed the tree");
+    return;
+  }
+  tree.removeMany(gone);
+  for (uint32_t h : gone) {
+    o.index.items.erase(h);
+    o.payloads.erase(h);
+  }
+  FUZZ_CHECK(tree.size() == o.index.items.size(), "removeMany left %u elements, expected %zu", tree.size(), o.index.items.size());
 }
 
 void query(FuzzInput& in, const OctoBvh& tree, const Oracle& o, float anchor) {
@@ -173,6 +207,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         switch (in.below(16)) {
           case 0: tree.clear(); o = Oracle{}; break;
           case 1: checkCanonical(tree, o); break;
+          case 2: case 3: removeMany(in, tree, o); break;
           default: query(in, tree, o, anchor);
         }
     }

@@ -352,6 +352,105 @@ TEST(OctoBvh, SmallMovesAndResizesKeepTheTreeCanonical) {
   }
 }
 
+// removeMany takes many elements out in one walk: the tree must be the one that removing them
+// one by one leaves (a twin tree does that), valid and answering as brute force does, for
+// random subsets, a half-space cut (a grid losing a part), the giants of a plate stack (forced
+// clusters emptied), everything, and a few (the one-by-one path); bad lists change nothing.
+TEST(OctoBvh, RemoveManyLeavesWhatOneByOneRemovalsLeave) {
+  for (const Vec3f& offset : {Vec3f(0, 0, 0), Vec3f(-3e5f, 7e5f, 2e5f)}) {
+    SeededRandom r(offset.x() == 0 ? 71 : 72);
+    const std::vector<Aabb> boxes = mixedWorkload(4000, 9, offset);
+    OctoBvh tree, twin;
+    test::BruteForceIndex ref, twinRef;
+    std::vector<uint32_t> live = insertMirrored(tree, ref, boxes);
+    insertMirrored(twin, twinRef, boxes);  // the same handles: both trees got the same inserts
+    const Aabb region = regionOf(boxes);
+    const float cutX = region.center().x();
+    for (int round = 0; round < 6; ++round) {
+      std::vector<uint32_t> gone, kept;
+      for (uint32_t h : live) {
+        const Aabb b = tree.bounds(h);
+        bool take = false;
+        switch (round) {
+          case 0: take = r.unit() < 0.3; break;                              // scattered
+          case 1: take = b.center().x() < cutX; break;                       // a half-space cut
+          case 2: take = b.extent().maxCoeff() > 20.f; break;                // the giants
+          case 3: take = gone.size() < 10 && r.unit() < 0.1; break;          // a few
+          case 4: take = r.unit() < 0.9; break;                              // most
+          default: take = true;                                              // the rest
+        }
+        (take ? gone : kept).push_back(h);
+      }
+      if (round == 0) {
+        // Bad lists first: a dead handle, a handle listed twice; nothing may change.
+        const uint64_t before = tree.structureHash();
+        std::vector<uint32_t> bad = gone;
+        bad.push_back(gone.front());
+        EXPECT_THROW(tree.removeMany(bad), InvalidInput);
+        bad.back() = 0xFFFFFFF0u;
+        EXPECT_THROW(tree.removeMany(bad), InvalidInput);
+        // Short lists (removed one by one) are checked whole first too.
+        EXPECT_THROW(tree.removeMany(std::vector<uint32_t>{gone[0], gone[1], gone[0]}), InvalidInput);
+        EXPECT_THROW(tree.removeMany(std::vector<uint32_t>{gone[0], 0xFFFFFFF0u}), InvalidInput);
+        ASSERT_EQ(tree.structureHash(), before);
+        tree.validate();
+      }
+      tree.removeMany(gone);
+      for (uint32_t h : gone) {
+        twin.remove(h);
+        ref.items.erase(h);
+      }
+      live = kept;
+      tree.validate();
+      ASSERT_EQ(tree.size(), live.size());
+      ASSERT_EQ(tree.structureHash(), twin.structureHash()) << "round " << round;
+      ASSERT_EQ(tree.rootLevel(), twin.rootLevel()) << "round " << round;
+      if (!live.empty()) expectQueriesMatch(tree, ref, r, 40, region);
+    }
+    EXPECT_TRUE(tree.empty());
+    // An emptied tree takes elements again.
+    const std::vector<uint32_t> again = insertMirrored(tree, ref, boxes);
+    tree.validate();
+    EXPECT_EQ(tree.structureHash(), freshBuildHash(tree));
+  }
+}
+
+// Giants among small bricks sit in forced clusters: removing all but a few giants must hold them
+// at their node again, and removing every small brick under them must turn the forced cluster
+// back into the children, as single removals do.
+TEST(OctoBvh, RemoveManyUndoesForcedClusters) {
+  for (int keepGiants : {10, 40}) {
+    SeededRandom r(uint64_t(80 + keepGiants));
+    std::vector<Aabb> boxes = generatePlateStack(40, 120.f, 3);
+    const Aabb stack = regionOf(boxes);
+    for (int i = 0; i < 600; ++i) {  // half of them near the stack's axis, where the giants' nodes are
+      const float reach = i % 2 ? 1.f : 0.05f;
+      const Vec3f c(float(r.uniform(stack.min.x(), stack.max.x())) * reach, float(r.uniform(stack.min.y(), stack.max.y())),
+                    float(r.uniform(stack.min.z(), stack.max.z())) * reach);
+      const Vec3f h = Vec3f::Constant(float(r.logUniform(0.1, 1.0)));
+      boxes.push_back({c - h, c + h});
+    }
+    OctoBvh tree, twin;
+    test::BruteForceIndex ref, twinRef;
+    const std::vector<uint32_t> live = insertMirrored(tree, ref, boxes);
+    insertMirrored(twin, twinRef, boxes);
+    ASSERT_GT(tree.shapeStats().forcedClusters, 0u);
+    std::vector<uint32_t> gone;  // (at least 64: fewer are removed one by one)
+    for (uint32_t i = 0; i < live.size(); ++i)
+      if (i < 40 ? i % 4 != 0 && keepGiants < 40 : keepGiants == 40 || i % 5 == 0) gone.push_back(live[i]);  // 3 giants in 4 and small ones, or every small one
+    for (uint32_t i = uint32_t(gone.size()); i > 1; --i) std::swap(gone[i - 1], gone[r.below(i)]);
+    tree.removeMany(gone);
+    for (uint32_t h : gone) {
+      twin.remove(h);
+      ref.items.erase(h);
+    }
+    tree.validate();
+    EXPECT_EQ(tree.shapeStats().forcedClusters, twin.shapeStats().forcedClusters);
+    ASSERT_EQ(tree.structureHash(), twin.structureHash()) << "keeping " << keepGiants << " giants";
+    expectQueriesMatch(tree, ref, r, 40, stack);
+  }
+}
+
 TEST(OctoBvh, PlateStackForceSplitsAndUndoesThem) {
   const std::vector<Aabb> plates = generatePlateStack(300, 200.f, 4);
   OctoBvh tree;
