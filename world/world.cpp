@@ -366,18 +366,13 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
     stats_.debrisBricks += uint32_t(part.size());
     return;
   }
-  // The part keeps its bricks' grid coordinates: its grid sits where the old one is.
+  // The part keeps its bricks' grid coordinates: its grid sits where the old one is. Its bricks
+  // move over in bulk (one index build there, one bulk removal here) and take their links along.
   auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(part.size() + 1024)));
-  std::vector<Brick> bricks;
-  bricks.reserve(part.size());
-  for (uint32_t id : part) bricks.push_back(old.brick(id));
-  const std::vector<uint32_t> ids = grid->placeBricks(bricks);  // the index in one pass
+  if (recordingEdits_)
+    for (uint32_t id : part) editLog_.bricks.push_back({g, id, false, old.brick(id)});
+  const std::vector<uint32_t> ids = old.moveBricks(part, *grid);
   auto partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
-  for (uint32_t id : part) {
-    if (recordingEdits_) editLog_.bricks.push_back({g, id, false, old.brick(id)});
-    links_[g]->removing(id, ignored);
-    old.removeBrick(id);
-  }
   // Its centre of mass moves as that point of the old body did (v + w x r about the old body's
   // centre; a kinematic grid turns about its origin, which is its position); a static grid's
   // parts start at rest.

@@ -8,6 +8,10 @@
 
 namespace bw {
 
+namespace {
+constexpr uint32_t kMaxBricksPerTurn = 64;
+}  // namespace
+
 float BrickConnectivity::toleranceAt(const Aabb& a) {
   // Four float steps of the coordinates at hand, at least kTolerance: bricks far from the grid
   // origin are placed no finer than that.
@@ -44,22 +48,30 @@ BrickConnectivity::BrickConnectivity(const BrickGrid& grid) {
   });
 }
 
-BrickConnectivity::BrickConnectivity(const BrickConnectivity& from, std::span<const uint32_t> oldIds, std::span<const uint32_t> newIds) {
+BrickConnectivity::BrickConnectivity(BrickConnectivity& from, std::span<const uint32_t> oldIds, std::span<const uint32_t> newIds) {
+  const char* context = "BrickConnectivity (a part's links)";
   if (oldIds.size() != newIds.size())
-    throw InvalidInput("BrickConnectivity: " + std::to_string(oldIds.size()) + " old ids for " + std::to_string(newIds.size()) + " new ones");
+    throw InvalidInput(std::string(context) + ": " + std::to_string(oldIds.size()) + " old ids for " + std::to_string(newIds.size()) + " new ones");
   uint32_t top = 0;
   for (uint32_t id : newIds) top = std::max(top, id + 1);
+  // Old id -> new id, through a map sized by the old ids; checked whole before anything moves.
+  std::vector<uint32_t> renumber(from.adjacency_.size(), ~0u);
+  for (size_t k = 0; k < oldIds.size(); ++k) {
+    if (oldIds[k] >= from.adjacency_.size() || !from.live_[oldIds[k]])
+      throw InvalidInput(std::string(context) + ": brick " + std::to_string(oldIds[k]) + " is not linked");
+    renumber[oldIds[k]] = newIds[k];
+  }
+  for (uint32_t id : oldIds)
+    for (uint32_t n : from.adjacency_[id])
+      if (renumber[n] == ~0u) throw InvalidInput(std::string(context) + ": brick " + std::to_string(id) + " has a neighbour outside the part");
   adjacency_.resize(top);
   live_.assign(top, 0);
-  // Old id -> new id, through a map sized by the old ids (only the part's entries are read).
-  std::vector<uint32_t> renumber(from.adjacency_.size(), ~0u);
-  for (size_t k = 0; k < oldIds.size(); ++k) renumber.at(oldIds[k]) = newIds[k];
   for (size_t k = 0; k < oldIds.size(); ++k) {
     std::vector<uint32_t>& list = adjacency_[newIds[k]];
-    for (uint32_t n : from.adjacency_[oldIds[k]]) {
-      if (renumber[n] == ~0u) throw InvalidInput("BrickConnectivity: brick " + std::to_string(oldIds[k]) + " has a neighbour outside the part");
-      list.push_back(renumber[n]);
-    }
+    list = std::move(from.adjacency_[oldIds[k]]);
+    from.adjacency_[oldIds[k]].clear();
+    from.live_[oldIds[k]] = 0;
+    for (uint32_t& n : list) n = renumber[n];
     live_[newIds[k]] = 1;
   }
 }
@@ -138,26 +150,31 @@ void BrickConnectivity::detached(std::span<const uint32_t> seeds, std::vector<st
     owner_[scratch_[i]] = i;
   }
   uint32_t groups = k;  // groups of searches still growing and not reported
+  // Bricks each search takes per turn: one while the searches may still meet nearby (the
+  // common case ends within a few turns), then more, so the bookkeeping after each round
+  // (which searches ran dry) stays small beside the walk when a big piece is walked whole.
+  uint32_t perTurn = 1;
   while (groups > 1) {
-    // One brick per search, in turn.
     for (uint32_t i = 0; i < k && groups > 1; ++i) {
-      if (heads_[i] == queues_[i].size()) continue;
-      const uint32_t u = queues_[i][heads_[i]++];
-      ++st.visited;
-      for (uint32_t v : adjacency_[u]) {
-        if (stamp_[v] != epoch_) {
-          stamp_[v] = epoch_;
-          owner_[v] = i;
-          queues_[i].push_back(v);
-          continue;
+      for (uint32_t taken = 0; taken < perTurn && heads_[i] < queues_[i].size() && groups > 1; ++taken) {
+        const uint32_t u = queues_[i][heads_[i]++];
+        ++st.visited;
+        for (uint32_t v : adjacency_[u]) {
+          if (stamp_[v] != epoch_) {
+            stamp_[v] = epoch_;
+            owner_[v] = i;
+            queues_[i].push_back(v);
+            continue;
+          }
+          if (owner_[v] == i) continue;  // this search's own brick (most edges)
+          const uint32_t a = find(i), b = find(owner_[v]);
+          if (a == b) continue;
+          parent_[std::max(a, b)] = std::min(a, b);  // the searches met: one part
+          --groups;
         }
-        if (owner_[v] == i) continue;  // this search's own brick (most edges)
-        const uint32_t a = find(i), b = find(owner_[v]);
-        if (a == b) continue;
-        parent_[std::max(a, b)] = std::min(a, b);  // the searches met: one part
-        --groups;
       }
     }
+    perTurn = std::min<uint32_t>(perTurn * 2, kMaxBricksPerTurn);
     // A group whose searches have all run dry has walked a whole part: it fell off.
     active_.assign(k, 0);
     for (uint32_t i = 0; i < k; ++i)

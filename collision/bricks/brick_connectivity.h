@@ -12,14 +12,14 @@
 ///   uint32_t newId = grid.placeBrick(b);
 ///   links.placed(grid, newId);
 ///
-/// detached() searches from every seed at once, one brick per search in turn, and joins two
-/// searches when they meet: the common case (the seeds still hang together through bricks
-/// near the removed one) ends as soon as all searches have met, after work bounded by the
-/// size of the loops around the removal, not by the grid. A search that runs out of bricks
-/// before meeting the others has walked a whole piece that fell off; because the searches
-/// advance in turn, that piece is found in time proportional to its own size (times the
-/// number of searches), and the piece still growing when all others are done (the big rest)
-/// is never walked.
+/// detached() searches from every seed at once, a few bricks per search in turn (1, 2, 4, ..
+/// up to 64 as the rounds go on), and joins two searches when they meet: the common case (the
+/// seeds still hang together through bricks near the removed one) ends as soon as all
+/// searches have met, after work bounded by the size of the loops around the removal, not by
+/// the grid. A search that runs out of bricks before meeting the others has walked a whole
+/// piece that fell off; because the searches advance in turn, that piece is found in time
+/// proportional to its own size (times the number of searches, plus one turn each), and the
+/// piece still growing when all others are done (the big rest) is never walked.
 /// Thread safety: const functions may run concurrently; the rest need exclusive access.
 #include <cstdint>
 #include <span>
@@ -47,10 +47,13 @@ class BrickConnectivity {
   /// Every brick's neighbours (one overlap query per brick).
   explicit BrickConnectivity(const BrickGrid& grid);
 
-  /// A part that detached() reported, moved into a grid of its own: its links are the old
-  /// ones (a detached part has no neighbour outside itself), renumbered from oldIds[k] to
-  /// newIds[k], with no query of the new grid. Call before the part's removing() calls.
-  BrickConnectivity(const BrickConnectivity& from, std::span<const uint32_t> oldIds, std::span<const uint32_t> newIds);
+  /// A part that detached() reported, moved into a grid of its own: its links are taken out of
+  /// `from` (a detached part has no neighbour outside itself, so no other list names its
+  /// bricks) and renumbered from oldIds[k] to newIds[k] in place: no query of the new grid, no
+  /// list allocated. In `from` the part's bricks are gone as if removing() had run for each.
+  /// InvalidInput (nothing taken) when the lengths differ, an old id is unknown or a brick has a
+  /// neighbour outside the part.
+  BrickConnectivity(BrickConnectivity& from, std::span<const uint32_t> oldIds, std::span<const uint32_t> newIds);
 
   /// Whether two bricks' bounds touch face to face (or overlap).
   static bool touches(const Aabb& a, const Aabb& b);

@@ -262,7 +262,40 @@ ShapeMoments canonicalBrickMoments(const Brick& b) {
   return m;
 }
 
+namespace {
+// A box's moments straight from its half sizes and rotation's permutation: the same
+// operations, in the same order, as the general formula below on a box (whose first moment is
+// zero and second diagonal), so the same bits (checked on every rotation in brick_grid_test),
+// at a fifth of its instructions; a grid's mass is this summed over every brick it gains or loses.
+ShapeMoments boxMoments(const Brick& b, double density, const Vec3d& reference) {
+  const double hx = b.halfSize.x(), hy = b.halfSize.y(), hz = b.halfSize.z();
+  const double volume = 8 * hx * hy * hz;
+  const double diagonal[3] = {volume * hx * hx / 3, volume * hy * hy / 3, volume * hz * hz / 3};
+  ShapeMoments m;
+  m.volume = density * volume;
+  double p[3], vp[3];
+  for (int i = 0; i < 3; ++i) {
+    p[i] = double(b.position[i]) - reference[i];
+    vp[i] = m.volume * p[i];
+    m.first[i] = p[i] * m.volume + 0.0;  // (+ the rotated zero first moment: keeps -0 as it was)
+  }
+  const int8_t* axis = AxisRotation::table().axis[b.rotation.index()];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      // V p p^T + p (R first)^T + (R first) p^T + density R second R^T, with R first = 0.
+      const double rotated = i == j ? density * diagonal[axis[i]] : 0.0;
+      m.second(i, j) = ((vp[i] * p[j] + p[i] * 0.0) + 0.0 * p[j]) + rotated;
+    }
+  return m;
+}
+}  // namespace
+
 ShapeMoments brickMoments(const Brick& b, double density, const Vec3d& reference) {
+  if (b.shape == BrickShape::Box) return boxMoments(b, density, reference);
+  return generalBrickMoments(b, density, reference);
+}
+
+ShapeMoments generalBrickMoments(const Brick& b, double density, const Vec3d& reference) {
   const ShapeMoments c = canonicalBrickMoments(b);
   const Mat3d R = b.rotation.matrix().cast<double>();
   const Vec3d p = b.position.cast<double>() - reference;

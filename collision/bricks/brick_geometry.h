@@ -69,9 +69,13 @@ class MomentSum {
   }
 
  private:
+  // note: Knuth's branch-free two-sum: the same exact rounding error of s + x as Neumaier's
+  // ordered form (both exact, so the same bits), without its data-dependent branch (a moment
+  // entry's sign and size vary brick to brick: mispredicted half the time on a bulk move).
   static void twoSum(double& s, double& c, double x) {
     const double t = s + x;
-    c += std::abs(s) >= std::abs(x) ? (s - t) + x : (x - t) + s;
+    const double xIn = t - s, sIn = t - xIn;
+    c += (s - sIn) + (x - xIn);
     s = t;
   }
   void accumulate(const ShapeMoments& m, double sign) {
@@ -86,6 +90,9 @@ class MomentSum {
 ShapeMoments canonicalBrickMoments(const Brick& b);
 /// Moments of the placed brick about `reference` in the grid frame, scaled by density.
 ShapeMoments brickMoments(const Brick& b, double density, const Vec3d& reference);
+/// The same through the canonical moments and rotation matrix for every shape (brickMoments
+/// takes a shortcut for boxes with the same result bits; kept to check that).
+ShapeMoments generalBrickMoments(const Brick& b, double density, const Vec3d& reference);
 
 /// Exact ray/brick-shape intersection in the grid frame: entry t within [0, tMax] and the
 /// outward normal of the entered face (grid frame). A ray starting inside reports t = 0 and the

@@ -58,13 +58,19 @@ std::vector<uint32_t> BrickGrid::placeBricks(const std::vector<Brick>& bricks) {
     throw CapacityExceeded("BrickGrid::placeBricks: " + std::to_string(bricks.size()) + " bricks exceed the grid's capacity of " +
                            std::to_string(config_.maxBricks));
   std::vector<Aabb> bounds;
-  std::vector<uint32_t> filters, ids;
   bounds.reserve(bricks.size());
   for (const Brick& b : bricks) {
     validateBrick(b, "BrickGrid::placeBricks");
     bounds.push_back(brickBounds(b));
-    filters.push_back(b.filter);
   }
+  return placeValidBricks(bricks, bounds);
+}
+
+std::vector<uint32_t> BrickGrid::placeValidBricks(const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds) {
+  std::vector<uint32_t> filters, ids;
+  filters.reserve(bricks.size());
+  ids.reserve(bricks.size());
+  for (const Brick& b : bricks) filters.push_back(b.filter);
   for (size_t i = 0; i < bricks.size(); ++i) ids.push_back(bricks_.allocate());
   std::vector<uint32_t> elements;
   try {
@@ -85,6 +91,53 @@ std::vector<uint32_t> BrickGrid::placeBricks(const std::vector<Brick>& bricks) {
   peakSecond_ = std::max(peakSecond_, moments_.value().second.trace());
   ++edits_;
   return ids;
+}
+
+std::vector<uint32_t> BrickGrid::moveBricks(std::span<const uint32_t> ids, BrickGrid& into) {
+  const char* context = "BrickGrid::moveBricks";
+  if (&into == this) throw InvalidInput(std::string(context) + ": a grid cannot move bricks into itself");
+  if (into.bricks_.size() != 0)
+    throw InvalidInput(std::string(context) + ": the grid moved into must be empty (it has " + std::to_string(into.bricks_.size()) + " bricks)");
+  if (into.config_.density != config_.density) throw InvalidInput(std::string(context) + ": the grids' material densities differ");
+  if (ids.size() > into.config_.maxBricks)
+    throw CapacityExceeded(std::string(context) + ": " + std::to_string(ids.size()) + " bricks exceed the capacity of the grid moved into (" +
+                           std::to_string(into.config_.maxBricks) + ")");
+  std::vector<uint8_t> listed(bricks_.indexBound(), 0);
+  for (uint32_t id : ids) {
+    if (!bricks_.isLive(id)) throw InvalidInput(std::string(context) + ": brick " + std::to_string(id) + " is not in this grid");
+    if (listed[id]++) throw InvalidInput(std::string(context) + ": brick " + std::to_string(id) + " is listed twice");
+  }
+  std::vector<Brick> bricks;
+  std::vector<Aabb> bounds;
+  std::vector<uint32_t> elements;
+  bricks.reserve(ids.size());
+  bounds.reserve(ids.size());
+  elements.reserve(ids.size());
+  for (uint32_t id : ids) {
+    bricks.push_back(bricks_.get<0>(id));
+    const uint32_t e = bricks_.get<1>(id);
+    bounds.push_back(index_.bounds(e));  // the brick's bounds as indexed (brickBounds of it)
+    elements.push_back(e);
+  }
+  // note: the bricks are valid (they were placed here) and `into` was checked: placing them
+  // there cannot throw but for an allocation failure, so nothing is half-moved.
+  // note: one after the other, not at once: tried on two threads (50k bricks), the build took
+  // 9 -> 15-18 ms and the removal 6 -> 17-19 ms, slower in all than one thread. Likely the
+  // kernel: the removal gives emptied pool pages back (madvise) while the build faults new
+  // ones in, and each release must flush the other core's TLB; not isolated further.
+  std::vector<uint32_t> moved = into.placeValidBricks(bricks, bounds);
+  index_.removeMany(elements);
+  for (uint32_t id : ids) bricks_.free(id);
+  if (bricks_.size() == 0) {
+    moments_.clear();
+    peakSecond_ = 0;
+    referenceSet_ = false;
+  } else {
+    for (const Brick& b : bricks) moments_.subtract(brickMoments(b, config_.density[b.material], reference_));
+    rebaseIfCancelling();
+  }
+  ++edits_;
+  return moved;
 }
 
 void BrickGrid::removeBrick(uint32_t id) {

@@ -14,6 +14,7 @@
 /// convexApproximation() (which refreshes a cache) need exclusive access.
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "collision/bricks/brick.h"
@@ -114,6 +115,13 @@ class BrickGrid {
   /// their ids in order.
   /// Throws InvalidInput (a bad brick, a grid not empty) or CapacityExceeded, placing nothing.
   std::vector<uint32_t> placeBricks(const std::vector<Brick>& bricks);
+  /// Moves bricks (live, distinct ids) out of this grid into `into`, an empty grid of the same
+  /// densities, keeping their grid coordinates: one index build there, one bulk removal here
+  /// (OctoBvh::removeMany), no brick validated again. Both indices end as placing and removing
+  /// one by one would leave them; mass properties agree with that to rounding. Returns the new
+  /// ids in order. Throws InvalidInput (a bad or repeated id, `into` not empty or this grid,
+  /// other densities) or CapacityExceeded, moving nothing.
+  std::vector<uint32_t> moveBricks(std::span<const uint32_t> ids, BrickGrid& into);
   /// Counts edits; caches keyed on it are stale when it changes.
   uint64_t editCount() const { return edits_; }
 
@@ -184,6 +192,8 @@ class BrickGrid {
   std::array<CachedApproximation, 8> approximations_;
 
   float roundingMargin(const Vec3f& queryPoint) const;
+  /// placeBricks' work once the bricks are known to be valid and the grid empty.
+  std::vector<uint32_t> placeValidBricks(const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
   void rebaseIfCancelling();
 };
 

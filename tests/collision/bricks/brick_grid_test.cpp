@@ -1,6 +1,7 @@
 // Brick shapes and grids: exact geometry, mass properties, raycasts and contacts against brute
 // force over every brick, collision LOD, convex approximation, grid vs grid, edits, bad input.
 #include <algorithm>
+#include <cstring>
 #include <gtest/gtest.h>
 #include <map>
 
@@ -66,6 +67,24 @@ TEST(BrickGeometry, MomentsMatchNumericalIntegration) {
     EXPECT_NEAR(num.volume, exact.volume, 0.03 * exact.volume) << "shape " << k % 4;
     EXPECT_LT((num.first - exact.first).norm(), 0.03 * exact.volume * (scale + ref.norm())) << "shape " << k % 4;
     EXPECT_LT((num.second - exact.second).norm(), 0.05 * exact.second.norm()) << "shape " << k % 4;
+  }
+}
+
+// Boxes take a shortcut to their moments: bit for bit the general formula's result (state hashes
+// depend on it), for every rotation, offsets with zero and negative-zero components, far points.
+TEST(BrickGeometry, BoxMomentsShortcutGivesTheGeneralFormulasBits) {
+  SeededRandom r(12);
+  for (int k = 0; k < 20000; ++k) {
+    Brick b = Brick::box(Vec3f::Zero(), Vec3f(float(r.logUniform(0.01, 500)), float(r.logUniform(0.01, 500)), float(r.logUniform(0.01, 500))));
+    b.rotation = AxisRotation::fromIndex(k % 24);
+    const int mode = int(r.below(4));
+    if (mode > 0) b.position = Vec3f(float(r.uniform(-1e5, 1e5)), mode == 2 ? -0.f : float(r.uniform(-10, 10)), float(r.uniform(-3e3, 3e3)));
+    const Vec3d reference = mode == 3 ? b.position.cast<double>() : Vec3d(r.uniform(-100, 100), 0.0, -0.0);
+    const double density = k % 2 ? 1.0 : 2.5;
+    const ShapeMoments fast = brickMoments(b, density, reference), general = generalBrickMoments(b, density, reference);
+    ASSERT_EQ(std::memcmp(&fast.volume, &general.volume, sizeof(double)), 0) << k;
+    ASSERT_EQ(std::memcmp(fast.first.data(), general.first.data(), 3 * sizeof(double)), 0) << k;
+    ASSERT_EQ(std::memcmp(fast.second.data(), general.second.data(), 9 * sizeof(double)), 0) << k;
   }
 }
 
@@ -420,7 +439,7 @@ TEST(BrickGrid, BadBricksAndQueriesAreRejectedWithoutChanges) {
 // placeBricks (a part split off a grid, a scene's build) against placing the same bricks one
 // by one: the same ids, tree, mass properties and answers; refused whole when it cannot place all.
 TEST(BrickGrid, PlacingManyAtOnceEqualsPlacingThemOneByOne) {
-  for (const Vec3f offset : {Vec3f(0, 0, 0), Vec3f(3.0e4f, -2.0e4f, 500.f)}) {
+  for (const Vec3f& offset : {Vec3f(0, 0, 0), Vec3f(3.0e4f, -2.0e4f, 500.f)}) {
     const std::vector<Brick> bricks = randomBuild(17, 3000, offset);
     BrickGrid one, many;
     std::vector<uint32_t> oneIds;
@@ -451,6 +470,59 @@ TEST(BrickGrid, PlacingManyAtOnceEqualsPlacingThemOneByOne) {
   BrickGrid small(BrickGrid::Config(4));
   EXPECT_THROW(small.placeBricks(randomBuild(5, 9, Vec3f::Zero())), CapacityExceeded);
   EXPECT_EQ(small.brickCount(), 0u);
+}
+
+// moveBricks hands a part of a grid to an empty grid: both indices as one-by-one placing and
+// removing leave them, mass properties the direct sums, for a scattered subset and a half-space
+// cut, near the origin and far from it; a bad list moves nothing.
+TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
+  for (const Vec3f& offset : {Vec3f(0, 0, 0), Vec3f(-6.0e4f, 2.0e4f, 9.0e4f)}) {
+    BrickGrid::Config config;
+    config.density[2] = 3.f;
+    const std::vector<Brick> bricks = randomBuild(23, 3000, offset);
+    for (int cut = 0; cut < 2; ++cut) {
+      BrickGrid grid(config), twin(config);
+      std::vector<uint32_t> ids;
+      for (const Brick& b : bricks) {
+        ids.push_back(grid.placeBrick(b));
+        twin.placeBrick(b);
+      }
+      SeededRandom r(uint64_t(31 + cut));
+      std::vector<uint32_t> part;
+      for (uint32_t id : ids)
+        if (cut ? grid.brick(id).position.x() < offset.x() + 20.f : r.unit() < 0.4) part.push_back(id);
+      for (uint32_t i = uint32_t(part.size()); i > 1; --i) std::swap(part[i - 1], part[r.below(i)]);
+      BrickGrid into(config);
+      // Bad lists first: nothing may move.
+      std::vector<uint32_t> bad = part;
+      bad.push_back(part.front());
+      EXPECT_THROW(grid.moveBricks(bad, into), InvalidInput);
+      bad.back() = 999999;
+      EXPECT_THROW(grid.moveBricks(bad, into), InvalidInput);
+      EXPECT_THROW(grid.moveBricks(part, grid), InvalidInput);
+      EXPECT_EQ(grid.brickCount(), bricks.size());
+      EXPECT_EQ(into.brickCount(), 0u);
+      const std::vector<uint32_t> moved = grid.moveBricks(part, into);
+      ASSERT_EQ(moved.size(), part.size());
+      std::vector<Brick> partBricks;
+      for (uint32_t id : part) {
+        partBricks.push_back(twin.brick(id));
+        twin.removeBrick(id);
+      }
+      BrickGrid twinPart(config);
+      for (const Brick& b : partBricks) twinPart.placeBrick(b);
+      for (size_t k = 0; k < part.size(); ++k) ASSERT_EQ(into.brick(moved[k]).position, partBricks[k].position);
+      grid.index().validate();
+      into.index().validate();
+      EXPECT_EQ(grid.index().structureHash(), twin.index().structureHash()) << "cut " << cut;
+      EXPECT_EQ(into.index().structureHash(), twinPart.index().structureHash()) << "cut " << cut;
+      expectMassMatchesDirectSum(grid, config, offset.cast<double>());
+      expectMassMatchesDirectSum(into, config, offset.cast<double>());
+      uint32_t stays = 0;
+      grid.forEachBrick([&](uint32_t id) { stays = id; });
+      EXPECT_THROW(grid.moveBricks(std::vector<uint32_t>{stays}, into), InvalidInput) << "into is not empty";
+    }
+  }
 }
 
 }  // namespace
