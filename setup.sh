@@ -14,7 +14,9 @@ packages=(
   libcli11-dev         # CLI11: the brickworld CLI
   nlohmann-json3-dev   # scene files, JSON output
   zlib1g-dev           # .brs save sections
-  python3              # plot scripts read CSV (matplotlib is optional)
+  python3              # plot scripts read CSV (matplotlib is optional); the browser test
+  libjs-three          # three.js r111: inlined into `brickworld view` pages
+  chromium-headless-shell  # the replay page's test (tests/recording/browser_check.py)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -67,6 +67,12 @@ const BrickGrid& World::grid(uint32_t index) const {
   return *grids_[index];
 }
 
+const std::string& World::gridName(uint32_t index) const {
+  if (index >= grids_.size())
+    throw InvalidInput("World::gridName: index is " + std::to_string(index) + ", the world has " + std::to_string(grids_.size()) + " grids");
+  return gridNames_[index];
+}
+
 uint32_t World::gridBody(const std::string& name) const {
   const auto it = std::find(gridNames_.begin(), gridNames_.end(), name);
   if (it != gridNames_.end()) {

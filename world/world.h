@@ -118,6 +118,9 @@ class World {
   uint32_t gridCount() const { return uint32_t(grids_.size()); }
   /// Grid `index` (< gridCount(), else InvalidInput), shared by every body that is a copy of it.
   const BrickGrid& grid(uint32_t index) const;
+  /// Grid `index`'s name (< gridCount(), else InvalidInput): the scene's, or "NAME/partK" and
+  /// "TERRAIN/slabK" for the parts split off at run time.
+  const std::string& gridName(uint32_t index) const;
   /// The body of the scene's grid named `name` (the first body using it); SceneError when no
   /// grid has that name.
   uint32_t gridBody(const std::string& name) const;
@@ -164,6 +167,8 @@ class World {
   uint32_t depenetratingCount() const { return uint32_t(depenetrating_.size()); }
   /// Dynamic bodies currently asleep.
   uint32_t sleepingCount() const { return sleep_.count(); }
+  /// Whether body `body` (< bodies().size()) is a dynamic body asleep.
+  bool asleep(uint32_t body) const { return sleep_.asleep(body); }
   /// Whether point `p` (world) is inside a brick of any grid body but `self`, or in a solid
   /// terrain voxel (containment.h).
   /// staticGrids false leaves static grids out (the containment tracker tests them by the

@@ -175,6 +175,14 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
       ->check(CLI::Range(1, 1024));
   cmd.add_option("--csv", scene->csvPath, "scene: write per-frame stage times to this CSV");
   cmd.add_option("--trace", scene->tracePath, "scene: write a Chrome trace (open in Perfetto)");
+  cmd.add_option("--record", scene->recordPath,
+                 "scene: record the run (geometry, per-frame poses, states, edits, splits, stage times; recording/FORMAT.md) "
+                 "for `brickworld view`");
+  cmd.add_flag("--record-contacts", scene->recordContacts, "scene: the recording also carries every frame's contacts");
+  cmd.add_flag("--record-gzip", scene->recordGzip, "scene: compress the recording (gzip; ~4x smaller with terrain, slower to write)");
+  cmd.add_option("--record-bricks", scene->recordBricks,
+                 "scene: grids with more bricks than this are recorded as their OctoBVH boxes (default 300000)")
+      ->check(CLI::Range(0u, 100'000'000u));
   cmd.add_option("--engine", scene->engine,
                  "scene: brickworld (default); bullet (as a Bullet expert sets it up: chunk compounds, CCD) or bullet-naive "
                  "(one compound per grid); both (brickworld and bullet) or all: same initial state, ratios and accuracy")

@@ -16,6 +16,7 @@
 #include "cli/render_figures.h"
 #include "cli/series.h"
 #include "cli/output_check.h"
+#include "recording/recording_writer.h"
 #include "world/bullet_baseline.h"
 #include "world/scene_checks.h"
 #include "world/scene_file.h"
@@ -232,6 +233,7 @@ int runScene(const SceneRunOptions& o) {
     throw SceneError(path + ": --submission " + o.submission + ": the scene declares no attachments (no render thread to submit to)");
   requireWritable(o.tracePath, "--trace");
   requireWritable(o.csvPath, "--csv");
+  requireWritable(o.recordPath, "--record");
   ProgressWatch watch(o.progress);
   const auto tBuild = Clock::now();
   watch.begin("building the scene");
@@ -264,6 +266,14 @@ int runScene(const SceneRunOptions& o) {
   ContainmentTracker containment(world);  // updated after each step, outside its timing
   SceneCheckTracker checks(world);        // the scene's own checks, likewise
   RenderFigures render;
+  std::unique_ptr<RecordingWriter> recording;
+  if (!o.recordPath.empty()) {
+    RecordingOptions ro;
+    ro.contacts = o.recordContacts;
+    ro.gzip = o.recordGzip;
+    ro.maxGridBricks = o.recordBricks;
+    recording = std::make_unique<RecordingWriter>(world, o.recordPath, ro, o.threads);
+  }
   const auto tRun = Clock::now();
   double simulationMs = 0;  // the steps' own time; the rest of the run is bookkeeping
   for (uint32_t f = 0; f < frames; ++f) {
@@ -275,6 +285,7 @@ int runScene(const SceneRunOptions& o) {
     simulationMs += s.totalMs;
     containment.update();
     checks.update();
+    if (recording) recording->frame(world, containment.report());
     endDeepest = deepestContact(world);
     deepest = std::max(deepest, endDeepest);
     total.v.push_back(s.totalMs);
@@ -326,6 +337,7 @@ int runScene(const SceneRunOptions& o) {
     span += ws.spanMs;
   }
   if (!o.tracePath.empty()) world.profiler().writeChromeTrace(o.tracePath);
+  if (recording) recording->finish();
   // Bookkeeping: everything the run did besides stepping (containment checks, deepest contact,
   // counters, CSV, work/span, the trace), against the simulation's own time.
   const double bookkeepingMs = std::chrono::duration<double, std::milli>(Clock::now() - tRun).count() - simulationMs;
@@ -381,6 +393,7 @@ int runScene(const SceneRunOptions& o) {
                      {"bookkeeping_share", bookkeepingMs / std::max(simulationMs, 1e-9)}};
     if (inside.count()) j["inside_solid"] = insideSolidList(inside, bodies.position);
     if (checks.any()) j["checks"] = checksJson(checks);
+    if (recording) j["recording"] = {{"file", o.recordPath}, {"frames", recording->frames()}, {"bytes_uncompressed", recording->bytes()}};
     if (!settled.empty()) j["drift_after_frame"] = {{"frame", o.driftAfter}, {"max_displacement_m", drift}};
     if (!scene.terrains.empty()) {
       j["terrain_contacts_per_frame"] = double(terrainContacts) / frames;
@@ -474,6 +487,9 @@ int runScene(const SceneRunOptions& o) {
   std::printf("  work %.1f ms, span %.1f ms over the run\n", work, span);
   if (!o.csvPath.empty()) std::printf("  per-frame CSV: %s\n", o.csvPath.c_str());
   if (!o.tracePath.empty()) std::printf("  Chrome trace: %s (open in Perfetto)\n", o.tracePath.c_str());
+  if (recording)
+    std::printf("  recording: %s (%u frames, %.1f MB%s; brickworld view %s -o PAGE.html)\n", o.recordPath.c_str(), recording->frames(),
+                recording->bytes() / 1e6, o.recordGzip ? " before compression" : "", o.recordPath.c_str());
   bool modesAgree = true;
   if (world.render() && submissionName == "all") {
     nlohmann::json unused;

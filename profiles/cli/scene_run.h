@@ -15,6 +15,10 @@ struct SceneRunOptions {
   int threads = 1;
   std::string csvPath;      ///< per-frame stage times
   std::string tracePath;    ///< Chrome trace of the whole run
+  std::string recordPath;   ///< a recording of the run (recording/FORMAT.md), for `brickworld view`
+  bool recordContacts = false;  ///< the recording carries every frame's contacts
+  bool recordGzip = false;      ///< the recording is one gzip stream
+  uint32_t recordBricks = 300'000;  ///< grids above this many bricks are recorded as their OctoBVH boxes
   bool json = false;
   bool progress = true;
   /// brickworld; bullet (Bullet as an expert sets it up) or bullet-naive (one compound per grid);
