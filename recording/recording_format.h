@@ -21,7 +21,7 @@ constexpr uint32_t recordingTag(const char (&s)[5]) {
 inline constexpr uint32_t kTagHead = recordingTag("HEAD"), kTagGrid = recordingTag("GRID"), kTagTerrain = recordingTag("TERR"),
                           kTagBody = recordingTag("BODY"), kTagEdit = recordingTag("EDIT"), kTagSplit = recordingTag("SPLT"),
                           kTagFrame = recordingTag("FRAM"), kTagContacts = recordingTag("CONT"), kTagEnd = recordingTag("END_"),
-                          kTagNodes = recordingTag("NODE");
+                          kTagNodes = recordingTag("NODE"), kTagMode = recordingTag("MODE");
 
 enum class RecordedKind : uint8_t { Sphere = 0, Box = 1, Capsule = 2, Grid = 3, Terrain = 4, Hull = 5 };
 enum class RecordedState : uint8_t { Awake = 0, Asleep = 1, InsideSolid = 2, PushedOut = 3 };

@@ -309,6 +309,22 @@ Recording parseRecording(std::span<const uint8_t> bytes, const std::string& name
       }
       r.end();
       rec.frames.back().contacts = n;
+    } else if (tag == kTagMode) {
+      RecordedSubmissionMode m;
+      const uint32_t nameLength = r.get<uint32_t>("name length");
+      const auto nameBytes = r.bytes(nameLength, "the mode's name");
+      m.name.assign(nameBytes.begin(), nameBytes.end());
+      const uint32_t n = r.get<uint32_t>("frame count");
+      if (n != rec.frames.size()) r.fail("times for " + std::to_string(n) + " frames, the recording holds " + std::to_string(rec.frames.size()));
+      r.fits(n, 16, "frame times");
+      for (uint32_t f = 0; f < n; ++f) {
+        m.updateMs.push_back(r.finite("a transform update time"));
+        m.submissionMs.push_back(r.finite("a submission time"));
+        m.commitMs.push_back(r.finite("a commit time"));
+        m.waitMs.push_back(r.finite("a render wait time"));
+      }
+      r.end();
+      rec.modes.push_back(std::move(m));
     } else if (tag == kTagEnd) {
       const uint32_t frames = r.get<uint32_t>("frame count");
       if (frames != rec.frames.size()) r.fail("says " + std::to_string(frames) + " frames, the file holds " + std::to_string(rec.frames.size()));

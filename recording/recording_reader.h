@@ -55,6 +55,12 @@ struct RecordedFrame {
   uint32_t bricksEdited = 0, splits = 0, terrainChunks = 0, contacts = 0;
 };
 
+/// MODE: one submission mode's render-frame times, per frame.
+struct RecordedSubmissionMode {
+  std::string name;
+  std::vector<float> updateMs, submissionMs, commitMs, waitMs;
+};
+
 struct Recording {
   nlohmann::json head;
   Vec3d origin = Vec3d::Zero();
@@ -66,6 +72,7 @@ struct Recording {
   std::vector<std::map<uint64_t, uint32_t>> terrainTriangles;
   std::vector<RecordedBody> bodies;  ///< by body id
   std::vector<RecordedFrame> frames;
+  std::vector<RecordedSubmissionMode> modes;  ///< `--submission all` runs
   bool complete = false;             ///< END_ was read (the run finished)
 };
 

@@ -122,6 +122,10 @@ RecordingWriter::~RecordingWriter() {
 }
 
 void RecordingWriter::block(uint32_t tag, const ByteSink& payload) {
+  if (payload.bytes.size() > UINT32_MAX)
+    throw InvalidInput("--record: a block of " + std::to_string(payload.bytes.size()) +
+                       " bytes does not fit the format's 32-bit length (a grid recorded brick by brick above ~119M bricks: lower "
+                       "--record-bricks)");
   const uint32_t header[2] = {tag, uint32_t(payload.bytes.size())};
   gzFile f = static_cast<gzFile>(file_);
   if (gzwrite(f, header, sizeof header) != int(sizeof header)) failed_ = true;
@@ -345,6 +349,22 @@ void RecordingWriter::frame(const World& world, const ContainmentReport& inside)
     block(kTagContacts, s);
   }
   ++frames_;
+}
+
+void RecordingWriter::submissionMode(const std::string& name, std::span<const double> update, std::span<const double> submission,
+                                     std::span<const double> commit, std::span<const double> wait) {
+  for (const auto& series : {update, submission, commit, wait})
+    if (series.size() != frames_)
+      throw InvalidInput("recording: submission mode " + name + " has " + std::to_string(series.size()) + " frames, the recording " +
+                         std::to_string(frames_));
+  ByteSink& s = scratch_;
+  s.bytes.clear();
+  s.put(uint32_t(name.size()));
+  s.put(name.data(), name.size());
+  s.put(frames_);
+  for (uint32_t f = 0; f < frames_; ++f)
+    for (const auto& series : {update, submission, commit, wait}) s.put(float(series[f]));
+  block(kTagMode, s);
 }
 
 void RecordingWriter::finish() {

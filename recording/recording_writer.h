@@ -13,6 +13,7 @@
 /// hash is the same with and without it); it turns the world's edit log on (World::recordEdits).
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -45,6 +46,11 @@ class RecordingWriter {
   /// The step just made: call once after every World::step(), with the containment report of
   /// the same state (bodies in it are drawn as inside solid).
   void frame(const World& world, const ContainmentReport& inside);
+  /// `--submission all`: the render frame's times of one submission mode, the run's frames made
+  /// again in that mode (ms per frame: transform update, submission, commit, wait for the render
+  /// thread; one value per recorded frame each, else InvalidInput). After the last frame().
+  void submissionMode(const std::string& name, std::span<const double> update, std::span<const double> submission,
+                      std::span<const double> commit, std::span<const double> wait);
   /// Writes END_ and closes the file; throws InvalidInput when a write failed (a full disk).
   void finish();
   /// Names of the stage times each frame carries, in order (the header's `stages`).

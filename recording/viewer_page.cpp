@@ -54,6 +54,11 @@ std::string defaultThreeJsDir() { return BW_THREE_JS_DIR; }
 
 ViewerPageStats writeViewerPage(const std::string& recordingPath, const std::string& pagePath, const std::string& threeDir) {
   const std::vector<uint8_t> bytes = readRecordingBytes(recordingPath);
+  // A page carries the recording in base64 and the browser decodes it whole: past a few hundred
+  // MB a tab runs out of memory (measured: a 52 MB page of a 1M-brick city loads in seconds).
+  if (bytes.size() > kMaxPageRecordingBytes)
+    throw InvalidInput("view: " + recordingPath + " holds " + std::to_string(bytes.size() >> 20) + " MiB; a page takes at most " +
+                       std::to_string(kMaxPageRecordingBytes >> 20) + " MiB: record fewer frames (--frames) or grids as boxes (--record-bricks)");
   const Recording rec = parseRecording(bytes, recordingPath);
   const std::string why = "three.js from Debian's libjs-three; setup.sh installs it, or give --three-dir";
   const std::string three = readText(threeDir + "/three.min.js", why) + "\n" +

@@ -15,6 +15,9 @@ struct ViewerPageStats {
   bool complete = false;        ///< the recording has its END_ (the run finished)
 };
 
+/// The largest recording a page embeds (bytes, decompressed).
+inline constexpr uint64_t kMaxPageRecordingBytes = uint64_t(512) << 20;
+
 /// Where three.js is read from unless told otherwise (libjs-three's install directory).
 std::string defaultThreeJsDir();
 

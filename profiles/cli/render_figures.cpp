@@ -65,7 +65,8 @@ void RenderFigures::print(const World& world) const {
 }
 
 bool compareSubmissionModes(const SceneDescription& scene, int threads, uint32_t frames, World& batchedWorld,
-                            const RenderFigures& batched, bool json, nlohmann::json& out) {
+                            const RenderFigures& batched, bool json, nlohmann::json& out,
+                            const std::function<void(const char* mode, const RenderFigures&)>& onMode) {
   bool same = true;
   const double batchedGame = (batched.submission.sum() + batched.commit.sum()) / frames;
   if (!json) std::printf("submission modes from the same initial state (%d thread(s), %u frames):\n", threads, frames);
@@ -89,6 +90,7 @@ bool compareSubmissionModes(const SceneDescription& scene, int threads, uint32_t
     }
   };
   row(submissionModeName(SubmissionMode::Batched), batched);
+  if (onMode) onMode(submissionModeName(SubmissionMode::Batched), batched);
   for (SubmissionMode mode : {SubmissionMode::PerObjectMutexNoRadius, SubmissionMode::PerObjectConcurrentNoRadius}) {
     World world(scene, threads, mode);
     RenderFigures f;
@@ -98,6 +100,7 @@ bool compareSubmissionModes(const SceneDescription& scene, int threads, uint32_t
     }
     f.finish(world);
     row(submissionModeName(mode), f);
+    if (onMode) onMode(submissionModeName(mode), f);
     same = same && f.sceneHash == batched.sceneHash && world.stateHash() == batchedWorld.stateHash();
   }
   if (json) out["render_scene_hashes_equal"] = same;

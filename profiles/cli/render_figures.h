@@ -3,6 +3,7 @@
 // times per frame, records, the render thread's busy time, the render-scene hash, and the
 // submission + commit time predicted at more threads from the run's work/span.
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -39,7 +40,9 @@ struct RenderFigures {
 /// `--submission all`: the scene run again in the per-object modes from the same initial state;
 /// prints (or adds to out) each mode's figures, the ratios to batched, and whether every
 /// render-scene hash equals batched's. Returns false when a hash differs.
+/// `onMode` (if set) sees each mode's figures, batched first (the recording keeps them).
 bool compareSubmissionModes(const SceneDescription& scene, int threads, uint32_t frames, World& batchedWorld,
-                            const RenderFigures& batched, bool json, nlohmann::json& out);
+                            const RenderFigures& batched, bool json, nlohmann::json& out,
+                            const std::function<void(const char* mode, const RenderFigures&)>& onMode = {});
 
 }  // namespace bw::cli

@@ -222,6 +222,8 @@ int runScene(const SceneRunOptions& o) {
     throw std::invalid_argument("--engine must be brickworld, bullet, bullet-naive, both or all (got '" + o.engine + "')");
   for (BulletSetup setup : setups) BulletBaseline::requireMirrorable(scene, setup);  // refuse before running ours
   if (o.engine == "bullet" || o.engine == "bullet-naive") {
+    if (!o.recordPath.empty())
+      throw std::invalid_argument("--record records brickworld's run; --engine " + o.engine + " runs only Bullet (use --engine both)");
     nlohmann::json b;
     runBullet(scene, o.threads, setups[0], o.bulletChunk, kinematicGridsFromName(o.bulletKinematic), o.frames ? o.frames : scene.settings.frames, o.json, b);
     if (o.json) std::cout << nlohmann::json{{"scene", scene.name}, {"engine", o.engine}, {"bullet", b}}.dump(2) << "\n";
@@ -337,7 +339,10 @@ int runScene(const SceneRunOptions& o) {
     span += ws.spanMs;
   }
   if (!o.tracePath.empty()) world.profiler().writeChromeTrace(o.tracePath);
-  if (recording) recording->finish();
+  // `--submission all` adds each mode's render times to the recording before it is closed.
+  const auto recordMode = [&](const char* mode, const RenderFigures& f) {
+    if (recording) recording->submissionMode(mode, f.update.v, f.submission.v, f.commit.v, f.wait.v);
+  };
   // Bookkeeping: everything the run did besides stepping (containment checks, deepest contact,
   // counters, CSV, work/span, the trace), against the simulation's own time.
   const double bookkeepingMs = std::chrono::duration<double, std::milli>(Clock::now() - tRun).count() - simulationMs;
@@ -425,8 +430,9 @@ int runScene(const SceneRunOptions& o) {
     if (world.render()) {
       j["render"] = render.json(world);
       if (submissionName == "all")
-        modesAgree = compareSubmissionModes(scene, o.threads, frames, world, render, true, j["submission_modes"]);
+        modesAgree = compareSubmissionModes(scene, o.threads, frames, world, render, true, j["submission_modes"], recordMode);
     }
+    if (recording) recording->finish();
     for (BulletSetup setup : setups) {
       nlohmann::json b;
       const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, kinematicGridsFromName(o.bulletKinematic), frames, true, b);
@@ -493,8 +499,9 @@ int runScene(const SceneRunOptions& o) {
   bool modesAgree = true;
   if (world.render() && submissionName == "all") {
     nlohmann::json unused;
-    modesAgree = compareSubmissionModes(scene, o.threads, frames, world, render, false, unused);
+    modesAgree = compareSubmissionModes(scene, o.threads, frames, world, render, false, unused, recordMode);
   }
+  if (recording) recording->finish();
   for (BulletSetup setup : setups) {
     nlohmann::json b;
     const double bulletMedian = runBullet(scene, o.threads, setup, o.bulletChunk, kinematicGridsFromName(o.bulletKinematic), frames, false, b);

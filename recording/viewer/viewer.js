@@ -24,7 +24,8 @@ function decodeBase64(text) {
 
 const TAG = (s) => s.charCodeAt(0) | (s.charCodeAt(1) << 8) | (s.charCodeAt(2) << 16) | (s.charCodeAt(3) << 24);
 const T_HEAD = TAG('HEAD'), T_GRID = TAG('GRID'), T_NODE = TAG('NODE'), T_TERR = TAG('TERR'), T_BODY = TAG('BODY'),
-      T_EDIT = TAG('EDIT'), T_SPLT = TAG('SPLT'), T_FRAM = TAG('FRAM'), T_CONT = TAG('CONT'), T_END = TAG('END_');
+      T_EDIT = TAG('EDIT'), T_SPLT = TAG('SPLT'), T_FRAM = TAG('FRAM'), T_CONT = TAG('CONT'), T_MODE = TAG('MODE'),
+      T_END = TAG('END_');
 
 // Reads a brick's 32 bytes at `o`.
 function readBrick(dv, o) {
@@ -38,7 +39,7 @@ function parseRecording(bytes) {
   const magic = String.fromCharCode(...bytes.subarray(0, 8));
   if (magic !== 'BWRECORD') throw new Error('not a brickworld recording');
   if (dv.getUint32(8, true) !== 1) throw new Error('recording version ' + dv.getUint32(8, true) + ', this page reads 1');
-  const rec = { head: null, grids: [], terrains: [], bodies: [], frames: [], complete: false };
+  const rec = { head: null, grids: [], terrains: [], bodies: [], frames: [], modes: [], complete: false };
   // What blocks before a frame's FRAM bring; the scene's start goes to `start` (frame -1).
   let pending = { edits: [], terrainChunks: [] };
   let started = false;
@@ -120,11 +121,18 @@ function parseRecording(bytes) {
         frame.states[k] = dv.getUint8(o + 32);
       }
       frame.total = frame.stageMs.reduce((a, b) => a + b, 0);
+      frame.inside = frame.states.reduce((n, state) => n + (state === 2), 0);
       rec.frames.push(frame);
       pending = { edits: [], terrainChunks: [] };
     } else if (tag === T_CONT) {
       const n = dv.getUint32(o, true);
       rec.frames[rec.frames.length - 1].contacts = new Float32Array(bytes.buffer.slice(bytes.byteOffset + o + 4, bytes.byteOffset + o + 4 + 28 * n));
+    } else if (tag === T_MODE) {
+      const nameLength = dv.getUint32(o, true);
+      const name = new TextDecoder().decode(bytes.subarray(o + 4, o + 4 + nameLength));
+      const n = dv.getUint32(o + 4 + nameLength, true);
+      const start = bytes.byteOffset + o + 8 + nameLength;
+      rec.modes.push({ name, times: new Float32Array(bytes.buffer.slice(start, start + 16 * n)) });  // update, submission, commit, wait
     } else if (tag === T_END) {
       rec.complete = true;
     }
@@ -223,36 +231,99 @@ function main() {
   const terrainMaterial = new THREE.MeshLambertMaterial({ color: 0x8d7b5a, side: THREE.DoubleSide });
   const tmp = new THREE.Matrix4();
 
-  // Grids: per grid and brick shape one instance buffer shared by every body that is a copy
-  // of the grid. Removed bricks leave a zero matrix in their slot until a placement reuses it.
+  // Grids: bricks in cells, a large grid's OctoBVH boxes of NODE level 3 (at most 512; one cell
+  // for grids under CELL_MIN bricks), and per cell and brick shape one instance buffer shared by
+  // every body that is a copy of the grid. Cells out of view are not drawn and far cells are
+  // drawn as their box (chooseDetail). Removed bricks leave a zero matrix until a placement
+  // reuses their slot.
+  const CELL_MIN = 20000;
+  // The cell whose box holds a point (grid frame): boxes hashed into a 16^3 lattice over their
+  // bounds; a point in no box (none should be: the boxes cover every brick) takes the nearest.
+  function cellFinder(boxes) {
+    const n = boxes.length / 6, R = 16;
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (let o = 0; o < boxes.length; o += 6)
+      for (let a = 0; a < 3; ++a) { lo[a] = Math.min(lo[a], boxes[o + a]); hi[a] = Math.max(hi[a], boxes[o + 3 + a]); }
+    const step = [0, 1, 2].map((a) => Math.max((hi[a] - lo[a]) / R, 1e-6));
+    const at = (v, a) => Math.min(R - 1, Math.max(0, Math.floor((v - lo[a]) / step[a])));
+    const lattice = Array.from({ length: R * R * R }, () => []);
+    for (let c = 0; c < n; ++c) {
+      const o = 6 * c;
+      for (let z = at(boxes[o + 2], 2); z <= at(boxes[o + 5], 2); ++z)
+        for (let y = at(boxes[o + 1], 1); y <= at(boxes[o + 4], 1); ++y)
+          for (let x = at(boxes[o], 0); x <= at(boxes[o + 3], 0); ++x) lattice[x + R * (y + R * z)].push(c);
+    }
+    return (x, y, z) => {
+      const list = lattice[at(x, 0) + R * (at(y, 1) + R * at(z, 2))];
+      let best = 0, bestDistance = Infinity;
+      for (const c of list.length ? list : [...Array(n).keys()]) {
+        const o = 6 * c;
+        const dx = Math.max(boxes[o] - x, 0, x - boxes[o + 3]), dy = Math.max(boxes[o + 1] - y, 0, y - boxes[o + 4]),
+              dz = Math.max(boxes[o + 2] - z, 0, z - boxes[o + 5]);
+        const d = dx * dx + dy * dy + dz * dz;
+        if (d === 0) return c;
+        if (d < bestDistance) { bestDistance = d; best = c; }
+      }
+      return best;
+    };
+  }
+  function boxSphere(boxes, from, to) {
+    const box = new THREE.Box3();
+    for (let o = 6 * from; o < 6 * to; o += 6) {
+      box.expandByPoint(new THREE.Vector3(boxes[o], boxes[o + 1], boxes[o + 2]));
+      box.expandByPoint(new THREE.Vector3(boxes[o + 3], boxes[o + 4], boxes[o + 5]));
+    }
+    return box.isEmpty() ? null : box.getBoundingSphere(new THREE.Sphere());
+  }
   const grids = rec.grids.map((g, gi) => {
-    const capacity = [0, 0, 0, 0];
-    for (const b of g.bricks.values()) capacity[b.shape]++;
-    for (const f of rec.frames) for (const e of f.edits) if (e.grid === gi && e.placed) capacity[e.brick.shape]++;
-    const attrs = capacity.map((n) => new THREE.InstancedBufferAttribute(new Float32Array(16 * Math.max(n, 1)), 16));
-    return { source: g, capacity, attrs, slots: null, free: null, used: null, meshes: [] };
+    let placements = 0;
+    for (let f = 0; f < F; ++f) for (const e of rec.frames[f].edits) placements += e.grid === gi && e.placed && g.frame < f;
+    const cellBoxes = g.hasBricks && g.bricks.size + placements >= CELL_MIN && g.levels.length >= 3 && g.levels[2].length >= 12 * 6
+                          ? g.levels[2] : null;
+    const cells = cellBoxes ? cellBoxes.length / 6 : 1;
+    const find = cellBoxes ? cellFinder(cellBoxes) : () => 0;
+    const capacity = Array.from({ length: cells }, () => [0, 0, 0, 0]);
+    for (const b of g.bricks.values()) capacity[find(b.px, b.py, b.pz)][b.shape]++;
+    for (let f = 0; f < F; ++f)
+      for (const e of rec.frames[f].edits)
+        if (e.grid === gi && e.placed && g.frame < f) capacity[find(e.brick.px, e.brick.py, e.brick.pz)][e.brick.shape]++;
+    const attrs = capacity.map((perShape) => perShape.map((n) => new THREE.InstancedBufferAttribute(new Float32Array(16 * Math.max(n, 1)), 16)));
+    const whole = g.levels.length ? boxSphere(g.levels[0], 0, g.levels[0].length / 6) : null;
+    const spheres = cellBoxes ? Array.from({ length: cells }, (_, c) => boxSphere(cellBoxes, c, c + 1)) : [whole];
+    // Per cell and shape a geometry of its own, shared only by the copies of this grid (which
+    // share the instance buffer too): three.js r111 does not bind an instanced mesh's matrices
+    // again when the previous draw used the same geometry and program, so two instanced meshes
+    // with one geometry and different buffers would draw the first one's instances twice.
+    const geometries = new Map();
+    const geometry = (c, s) => {
+      const key = c * 4 + s;
+      if (!geometries.has(key)) geometries.set(key, shapes[s].clone());
+      return geometries.get(key);
+    };
+    return { source: g, cellBoxes, find, capacity, attrs, spheres, geometry, slots: null, free: null, used: null };
   });
   function resetGrid(grid) {
     grid.slots = new Map();
-    grid.free = [[], [], [], []];
-    grid.used = [0, 0, 0, 0];
-    for (const a of grid.attrs) a.array.fill(0);
+    grid.free = grid.capacity.map(() => [[], [], [], []]);
+    grid.used = grid.capacity.map(() => [0, 0, 0, 0]);
+    for (const perShape of grid.attrs) for (const a of perShape) { a.array.fill(0); a.needsUpdate = true; }
     for (const [id, b] of grid.source.bricks) placeBrick(grid, id, b);
   }
   function placeBrick(grid, id, b) {
-    const s = b.shape;
-    const slot = grid.free[s].length ? grid.free[s].pop() : grid.used[s]++;
-    grid.slots.set(id, [s, slot]);
-    brickMatrix(b, rotations, tmp).toArray(grid.attrs[s].array, 16 * slot);
-    grid.attrs[s].needsUpdate = true;
+    const c = grid.find(b.px, b.py, b.pz), s = b.shape;
+    const slot = grid.free[c][s].length ? grid.free[c][s].pop() : grid.used[c][s]++;
+    grid.slots.set(id, [c, s, slot]);
+    brickMatrix(b, rotations, tmp).toArray(grid.attrs[c][s].array, 16 * slot);
+    grid.attrs[c][s].needsUpdate = true;
   }
   function removeBrick(grid, id) {
     const at = grid.slots.get(id);
     if (!at) return;
+    const [c, s, slot] = at;
     grid.slots.delete(id);
-    grid.attrs[at[0]].array.fill(0, 16 * at[1], 16 * at[1] + 16);
-    grid.attrs[at[0]].needsUpdate = true;
-    grid.free[at[0]].push(at[1]);
+    grid.attrs[c][s].array.fill(0, 16 * slot, 16 * slot + 16);
+    grid.attrs[c][s].needsUpdate = true;
+    grid.free[c][s].push(slot);
   }
   grids.forEach(resetGrid);
 
@@ -261,7 +332,7 @@ function main() {
     const boxes = rec.grids[g].levels[level];
     if (!boxes || boxes.length === 0) return null;
     const n = boxes.length / 6;
-    const mesh = new THREE.InstancedMesh(unitBox, material, n);
+    const mesh = new THREE.InstancedMesh(unitBox.clone(), material, n);
     for (let k = 0; k < n; ++k) {
       const o = 6 * k;
       tmp.makeScale(Math.max(boxes[o + 3] - boxes[o], 1e-4), Math.max(boxes[o + 4] - boxes[o + 1], 1e-4), Math.max(boxes[o + 5] - boxes[o + 2], 1e-4));
@@ -284,34 +355,32 @@ function main() {
       const grid = grids[b.ref];
       const material = b.motion === 2 ? stateMaterials[0] : gridMaterial(b.motion);
       const meshes = [];
+      let cellBox = null;
       if (grid.source.hasBricks) {
-        grid.attrs.forEach((attr, s) => {
-          if (grid.capacity[s] === 0) return;
-          const mesh = new THREE.InstancedMesh(shapes[s], material, grid.capacity[s]);
+        grid.attrs.forEach((perShape, c) => perShape.forEach((attr, s) => {
+          if (grid.capacity[c][s] === 0) return;
+          const mesh = new THREE.InstancedMesh(grid.geometry(c, s), material, grid.capacity[c][s]);
           mesh.instanceMatrix = attr;
+          mesh.userData.cell = c;
           mesh.userData.shape = s;
-          mesh.frustumCulled = false;
+          mesh.frustumCulled = false;  // culled per cell (chooseDetail): the unit geometry's bounds say nothing
           group.add(mesh);
           meshes.push(mesh);
-        });
+        }));
+        if (grid.cellBoxes) {
+          // A far cell's box: one instance per cell, zero-sized while the cell shows its bricks.
+          cellBox = new THREE.InstancedMesh(unitBox.clone(), material, grid.cellBoxes.length / 6);
+          cellBox.frustumCulled = false;
+          cellBox.instanceMatrix.array.fill(0);
+          group.add(cellBox);
+        }
       } else {
         const levels = grid.source.levels.length;
         const mesh = nodeBoxMesh(b.ref, levels - 1, material);
         if (mesh) { mesh.frustumCulled = false; group.add(mesh); meshes.push(mesh); }
       }
       scene.add(group);
-      // Bounds in the body's shape frame (its coarsest OctoBVH boxes) for the level of detail.
-      let bounds = null;
-      const coarsest = grid.source.levels.length ? grid.source.levels[0] : null;
-      if (coarsest && coarsest.length) {
-        const box = new THREE.Box3();
-        for (let o = 0; o < coarsest.length; o += 6) {
-          box.expandByPoint(new THREE.Vector3(coarsest[o], coarsest[o + 1], coarsest[o + 2]));
-          box.expandByPoint(new THREE.Vector3(coarsest[o + 3], coarsest[o + 4], coarsest[o + 5]));
-        }
-        bounds = box.getBoundingSphere(new THREE.Sphere());
-      }
-      bodyObjects[i] = { group, meshes, dynamic: b.motion === 2, grid: b.ref, bounds, lod: null };
+      bodyObjects[i] = { group, meshes, cellBox, dynamic: b.motion === 2, grid: b.ref, bounds: grid.spheres.length === 1 ? grid.spheres[0] : boxSphere(grid.source.levels[0], 0, grid.source.levels[0].length / 6), lod: null };
     } else if (b.kind === 4) {
       const group = new THREE.Group();
       group.matrixAutoUpdate = false;
@@ -323,12 +392,13 @@ function main() {
       primitiveCount[b.kind]++;
     }
   });
-  // Primitive instances: per kind and state (static primitives use state 0 in grey).
+  // Primitive instances: per kind and state (static primitives use state 0 in grey), each mesh
+  // with a geometry of its own (see the grids' geometry above).
   const primitiveMeshes = {};
   function primitiveMesh(geometry, kind, state, count) {
     const key = kind + ':' + state;
     if (!primitiveMeshes[key]) {
-      const mesh = new THREE.InstancedMesh(geometry, state < 0 ? staticMaterial : stateMaterials[state], Math.max(count, 1));
+      const mesh = new THREE.InstancedMesh(geometry.clone(), state < 0 ? staticMaterial : stateMaterials[state], Math.max(count, 1));
       mesh.frustumCulled = false;
       mesh.count = 0;
       scene.add(mesh);
@@ -448,8 +518,10 @@ function main() {
         obj.group.matrix.copy(pose);
         obj.group.matrixWorldNeedsUpdate = true;
         if (obj.dynamic) {
-          for (const m of obj.meshes) m.material = stateMaterials[state < 0 ? 0 : state];
-          if (obj.lod) obj.lod.material = stateMaterials[state < 0 ? 0 : state];
+          const material = stateMaterials[state < 0 ? 0 : state];
+          for (const m of obj.meshes) m.material = material;
+          if (obj.lod) obj.lod.material = material;
+          if (obj.cellBox) obj.cellBox.material = material;
         }
         return;
       }
@@ -489,8 +561,10 @@ function main() {
       const obj = bodyObjects[i];
       if (!obj || !obj.group.visible || b.kind !== 3 || !grids[b.ref].source.hasBricks) return;
       bricks += grids[b.ref].slots.size;
-      obj.meshes.forEach((m) => { m.count = grids[b.ref].used[m.userData.shape]; });
+      obj.meshes.forEach((m) => { m.count = grids[b.ref].used[m.userData.cell][m.userData.shape]; });
     });
+    listInside(frame);
+    report.insideSolid = frame.inside;
     report.frame = target;
     report.bodies = frame.bodyCount;
     report.bodiesDrawn = drawn;
@@ -501,6 +575,38 @@ function main() {
         ' ms, ' + frame.bodyCount + ' bodies' + (nc ? ', ' + nc + ' contacts' : '');
     drawTimeline();
     draw();
+  }
+
+  // The camera a few sizes away from body b as the shown frame has it.
+  function focusBody(b) {
+    const frame = rec.frames[shown], body = rec.bodies[b];
+    if (!body || !frame) return;
+    const k = frame.ids.indexOf(b);
+    const at = k >= 0 ? frame.poses.subarray(7 * k, 7 * k + 3) : body.pos;
+    const obj = bodyObjects[b];
+    const radius = obj && obj.bounds ? obj.bounds.radius : Math.max(...body.size, 0.5);
+    controls.target.set(at[0], at[1], at[2]);
+    camera.position.set(at[0] + 3 * radius, at[1] - 4 * radius, at[2] + 2.5 * radius);
+    controls.update();
+    draw();
+  }
+  // Bodies inside solid at the shown frame, each a link that looks at it.
+  const insideList = document.getElementById('inside');
+  function listInside(frame) {
+    insideList.textContent = '';
+    if (!frame.inside) return;
+    insideList.append('inside solid at this frame (' + frame.inside + '): ');
+    let listed = 0;
+    for (let k = 0; k < frame.ids.length && listed < 20; ++k) {
+      if (frame.states[k] !== 2) continue;
+      const link = document.createElement('a');
+      link.href = '#';
+      link.textContent = 'body ' + frame.ids[k];
+      const id = frame.ids[k];
+      link.addEventListener('click', (e) => { e.preventDefault(); focusBody(id); });
+      insideList.append(link, ' ');
+      ++listed;
+    }
   }
 
   // ---- the timeline: frame times stacked by stage; a click jumps to that frame ----
@@ -520,13 +626,62 @@ function main() {
     span.innerHTML = '<i style="background:#' + STATE_COLORS[k].toString(16).padStart(6, '0') + '"></i>body ' + name;
     legend.appendChild(span);
   });
+  // `--submission all`: a lane per submission mode below the stages, its render frame stacked
+  // as transform update, submission, commit and wait, on one scale for every lane.
+  const MODE_PARTS = ['update', 'submission', 'commit', 'render wait'], MODE_COLORS = ['#ff8fab', '#f4d35e', '#0ead69', '#5e6472'];
+  const LANE = 34, MAIN = 150;
+  // The lanes' scale: the 95th percentile of every lane's frames (a stray 17 ms frame would
+  // flatten the rest); taller frames are clipped and marked red.
+  const laneSums = rec.modes.map((m) => {
+    const sums = [];
+    for (let f = 0; f < F; ++f) sums.push(m.times[4 * f] + m.times[4 * f + 1] + m.times[4 * f + 2] + m.times[4 * f + 3]);
+    return sums;
+  });
+  const quantile = (values, q) => {
+    const sorted = values.slice().sort((a, b) => a - b);
+    return sorted.length ? sorted[Math.min(sorted.length - 1, Math.floor(q * sorted.length))] : 0;
+  };
+  const modeScale = Math.max(1.2 * quantile([].concat(...laneSums), 0.95), 1e-3);
+  timeline.height = MAIN + LANE * rec.modes.length;
+  if (rec.modes.length) MODE_PARTS.forEach((name, k) => {
+    const span = document.createElement('span');
+    span.innerHTML = '<i style="background:' + MODE_COLORS[k] + '"></i>mode lanes: ' + name;
+    legend.appendChild(span);
+  });
+  report.modeLanes = rec.modes.length;
+  function drawModeLanes(ctx, w, bar) {
+    rec.modes.forEach((m, lane) => {
+      const top = MAIN + LANE * lane, base = top + LANE - 4;
+      ctx.fillStyle = '#23292f';
+      ctx.fillRect(0, top, w, LANE - 2);
+      const width = Math.max(bar - (bar > 3 ? 1 : 0), 1), room = LANE - 8;
+      for (let f = 0; f < F; ++f) {
+        let y = base;
+        for (let k = 0; k < 4; ++k) {
+          const hh = Math.min((m.times[4 * f + k] / modeScale) * room, y - (base - room));
+          ctx.fillStyle = MODE_COLORS[k];
+          ctx.fillRect(f * bar, y - hh, width, hh);
+          y -= hh;
+        }
+        if (laneSums[lane][f] > modeScale) {
+          ctx.fillStyle = '#e23b3b';
+          ctx.fillRect(f * bar, base - room - 2, width, 2);
+        }
+      }
+      ctx.fillStyle = '#d8dde3';
+      ctx.font = '11px system-ui, sans-serif';
+      ctx.fillText(m.name + ': render frame median ' + quantile(laneSums[lane], 0.5).toFixed(3) + ' ms, max ' +
+                   Math.max(...laneSums[lane]).toFixed(3) + ' ms (lane height ' + modeScale.toFixed(3) + ' ms)', 4, top + 12);
+    });
+  }
   function drawTimeline() {
-    const w = timeline.clientWidth || 800, h = timeline.height;
+    const w = timeline.clientWidth || 800, h = MAIN;
     if (timeline.width !== w) timeline.width = w;
     const ctx = timeline.getContext('2d');
     ctx.fillStyle = '#1b1f24';
-    ctx.fillRect(0, 0, w, h);
+    ctx.fillRect(0, 0, w, timeline.height);
     const bar = w / Math.max(F, 1);
+    drawModeLanes(ctx, w, bar);
     const plot = h - 14;
     for (let f = 0; f < F; ++f) {
       let y = plot;
@@ -537,11 +692,15 @@ function main() {
         y -= hh;
       });
     }
+    // Frames that end with a body inside solid: a red mark on top.
+    ctx.fillStyle = '#e23b3b';
+    for (let f = 0; f < F; ++f) if (rec.frames[f].inside) ctx.fillRect(f * bar, 0, Math.max(bar, 2), 3);
     ctx.fillStyle = '#ffffff';
     ctx.fillRect(Math.max(shown, 0) * bar + bar / 2 - 1, 0, 2, plot);
+    if (rec.modes.length) ctx.fillRect(Math.max(shown, 0) * bar + bar / 2 - 1, MAIN, 2, timeline.height - MAIN);
     ctx.fillStyle = '#9aa5b1';
     ctx.font = '11px system-ui, sans-serif';
-    ctx.fillText('frame time, max ' + scaleMs.toFixed(2) + ' ms (click a frame to jump to it)', 4, h - 2);
+    ctx.fillText('frame time, max ' + scaleMs.toFixed(2) + ' ms (click a frame to jump to it; red on top: a body inside solid)', 4, h - 2);
     report.timelineFrames = F;
   }
   timeline.addEventListener('click', (e) => {
@@ -586,27 +745,53 @@ function main() {
     drawTimeline();
     draw();
   }
-  // Level of detail: a grid body drawn brick by brick whose bounds cover less than ~4% of the
-  // view's height is drawn as its OctoBVH boxes (NODE level 3: at most 512) instead.
-  const lodSphere = new THREE.Sphere();
+  // Level of detail and culling, per cell of a grid drawn brick by brick: a cell out of the view
+  // is not drawn; a cell (or a one-cell grid) whose bounds cover less than ~4% of the view's
+  // height is drawn as its box (one-cell grids: their NODE level 3 boxes, at most 512).
+  const lodSphere = new THREE.Sphere(), frustum = new THREE.Frustum(), viewProjection = new THREE.Matrix4();
+  const cellMatrix = new THREE.Matrix4();
   function chooseDetail() {
+    camera.updateMatrixWorld();
+    frustum.setFromMatrix(viewProjection.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse));
     const tanHalf = Math.tan((camera.fov * Math.PI) / 360);
-    let far = 0;
-    bodyObjects.forEach((obj, i) => {
-      if (!obj || obj.grid === undefined || !obj.group.visible || !grids[obj.grid].source.hasBricks) return;
-      if (!obj.bounds) return;
-      lodSphere.copy(obj.bounds).applyMatrix4(obj.group.matrix);
-      const distance = Math.max(lodSphere.center.distanceTo(camera.position), 1e-6);
-      const coarse = lodSphere.radius / (distance * tanHalf) < 0.04;
-      if (coarse && !obj.lod) {
-        obj.lod = nodeBoxMesh(obj.grid, Math.min(2, rec.grids[obj.grid].levels.length - 1), obj.meshes.length ? obj.meshes[0].material : staticMaterial);
-        if (obj.lod) { obj.lod.frustumCulled = false; obj.group.add(obj.lod); }
+    let coarseCells = 0, culledCells = 0, gridsAsBoxes = 0;
+    bodyObjects.forEach((obj) => {
+      if (!obj || obj.grid === undefined || !obj.group.visible) return;
+      const grid = grids[obj.grid];
+      if (!grid.source.hasBricks) return;
+      const state = grid.spheres.map((sphere, c) => {
+        if (!sphere) return 'fine';
+        lodSphere.copy(sphere).applyMatrix4(obj.group.matrix);
+        if (!frustum.intersectsSphere(lodSphere)) return 'culled';
+        const distance = Math.max(lodSphere.center.distanceTo(camera.position), 1e-6);
+        return lodSphere.radius / (distance * tanHalf) < 0.04 ? 'coarse' : 'fine';
+      });
+      for (const m of obj.meshes) m.visible = state[m.userData.cell] === 'fine';
+      if (obj.cellBox) {
+        const boxes = grid.cellBoxes, a = obj.cellBox.instanceMatrix.array;
+        state.forEach((st, c) => {
+          const o = 6 * c;
+          if (st === 'coarse') {
+            cellMatrix.makeScale(Math.max(boxes[o + 3] - boxes[o], 1e-4), Math.max(boxes[o + 4] - boxes[o + 1], 1e-4), Math.max(boxes[o + 5] - boxes[o + 2], 1e-4));
+            cellMatrix.setPosition((boxes[o] + boxes[o + 3]) / 2, (boxes[o + 1] + boxes[o + 4]) / 2, (boxes[o + 2] + boxes[o + 5]) / 2);
+            cellMatrix.toArray(a, 16 * c);
+          } else a.fill(0, 16 * c, 16 * c + 16);
+        });
+        obj.cellBox.instanceMatrix.needsUpdate = true;
+      } else if (state[0] === 'coarse') {
+        if (!obj.lod) {
+          obj.lod = nodeBoxMesh(obj.grid, Math.min(2, grid.source.levels.length - 1), obj.meshes.length ? obj.meshes[0].material : staticMaterial);
+          if (obj.lod) { obj.lod.frustumCulled = false; obj.group.add(obj.lod); }
+        }
+        if (!obj.lod) for (const m of obj.meshes) m.visible = true;  // no boxes to stand in
       }
-      if (obj.lod) obj.lod.visible = coarse;
-      for (const m of obj.meshes) m.visible = !coarse || !obj.lod;
-      far += coarse && obj.lod ? 1 : 0;
+      if (obj.lod) obj.lod.visible = state[0] === 'coarse' && !obj.cellBox;
+      gridsAsBoxes += !obj.cellBox && state[0] === 'coarse' && !!obj.lod;
+      for (const st of state) { coarseCells += st === 'coarse'; culledCells += st === 'culled'; }
     });
-    report.gridsAsBoxes = far;
+    report.gridsAsBoxes = gridsAsBoxes;
+    report.cellsAsBoxes = coarseCells;
+    report.cellsCulled = culledCells;
   }
   function draw() {
     chooseDetail();
@@ -666,20 +851,7 @@ function main() {
   if (F > 0) setFrame(wanted === 'last' ? F - 1 : wanted ? Number(wanted) : 0);
   if (params.has('grid')) updateNodeOverlay();
   // #body=N: look at body N from a few of its sizes away (where did it end up?).
-  if (params.has('body') && F > 0) {
-    const b = Number(params.get('body')), frame = rec.frames[shown];
-    const k = frame.ids.indexOf(b);
-    const body = rec.bodies[b];
-    if (body) {
-      const at = k >= 0 ? frame.poses.subarray(7 * k, 7 * k + 3) : body.pos;
-      const obj = bodyObjects[b];
-      const radius = obj && obj.bounds ? obj.bounds.radius : Math.max(...body.size, 0.5);
-      controls.target.set(at[0], at[1], at[2]);
-      camera.position.set(at[0] + 3 * radius, at[1] - 4 * radius, at[2] + 2.5 * radius);
-      controls.update();
-      draw();
-    }
-  }
+  if (params.has('body') && F > 0) focusBody(Number(params.get('body')));
   // #bench: the time of a draw, averaged over 20 (what the page costs a frame on this machine).
   if (params.has('bench')) {
     // A pixel read after each draw waits for the GPU (or the CPU's SwiftShader) to finish it.

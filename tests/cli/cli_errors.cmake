@@ -19,3 +19,9 @@ expect_failure("--csv: cannot write /nonexistent/dir/s.csv" sweep stack10 --fram
 expect_failure("--csv: cannot write /nonexistent/dir/t.csv" tradeoff stack10 --frames 1 --csv /nonexistent/dir/t.csv)
 expect_failure("--csv: cannot write /nonexistent/dir/b.csv" batch-bench --csv /nonexistent/dir/b.csv)
 expect_failure("expected a Brickadia save (.brs) or a MagicaVoxel model (.vox), got a '.json' file" inspect ${SCENES}/stack10.json)
+# Recordings: an unwritable one refused before the run, none for a Bullet-only run, and `view`
+# naming a missing or foreign file.
+expect_failure("--record: cannot write /nonexistent/dir/r.bwr" run city_rain --frames 1 --record /nonexistent/dir/r.bwr)
+expect_failure("--record records brickworld's run" run stack10 --frames 1 --engine bullet --record r.bwr)
+expect_failure("recording /nonexistent/r.bwr: cannot open it" view /nonexistent/r.bwr -o r.html)
+expect_failure("not a brickworld recording" view ${SCENES}/stack10.json -o r.html)

@@ -20,8 +20,8 @@ import zlib
 
 # scene, frames, extra run options, what the last frame must show
 SCENES = [
-    ("crates_on_grid", 90, ["--record-contacts"], {"contacts": True, "bricks": True}),
-    ("demolition", 120, [], {"bricks": True}),
+    ("crates_on_grid", 90, ["--record-contacts", "--submission", "all"], {"contacts": True, "bricks": True, "modes": 3}),
+    ("demolition", 120, [], {"bricks": True, "mark_inside": True}),
     ("quarry", 200, [], {"terrain": True}),
     ("city_rain", 60, [], {}),  # the city (1M bricks) drawn as its OctoBVH boxes
 ]
@@ -91,6 +91,25 @@ def png_pixels(path):
     return width, height, rows, bpp
 
 
+def mark_inside_solid(recording):
+    """Rewrites the last frame's first moving body as inside solid (an uncompressed recording):
+    the page must list it and mark the frame."""
+    data = bytearray(open(recording, "rb").read())
+    at, stages, last = 12, 0, None
+    while at + 8 <= len(data):
+        tag, length = struct.unpack_from("<4sI", data, at)
+        if tag == b"HEAD":
+            stages = len(json.loads(data[at + 8:at + 8 + length].decode())["stages"])
+        if tag == b"FRAM":
+            last = at
+        at += 8 + length
+    moving = struct.unpack_from("<I", data, last + 8 + 4 + 4 * stages + 4)[0]
+    if moving == 0:
+        fail(recording + ": no moving body to mark")
+    data[last + 8 + 4 + 4 * stages + 8 + 32] = 2
+    open(recording, "wb").write(bytes(data))
+
+
 def check_scene(brickworld, work, scene, frames, options, expect):
     recording = os.path.join(work, scene + ".bwr")
     page = os.path.join(work, scene + ".html")
@@ -99,6 +118,8 @@ def check_scene(brickworld, work, scene, frames, options, expect):
     if run.returncode != 0:
         fail("%s: brickworld run failed:\n%s" % (scene, run.stderr[-2000:]))
     ran = json.loads(run.stdout)
+    if expect.get("mark_inside"):
+        mark_inside_solid(recording)
     view = subprocess.run([brickworld, "view", recording, "-o", page], capture_output=True, text=True, timeout=300)
     if view.returncode != 0:
         fail("%s: brickworld view failed:\n%s" % (scene, view.stderr))
@@ -129,6 +150,11 @@ def check_scene(brickworld, work, scene, frames, options, expect):
         problems.append("bricks drawn %s, the run ended with %d" % (report.get("bricksDrawn"), ran["bricks"]))
     if expect.get("contacts") and not report.get("contactsDrawn"):
         problems.append("no contacts drawn")
+    if report.get("modeLanes", 0) != expect.get("modes", 0):
+        problems.append("%s submission-mode lanes, the run made %d" % (report.get("modeLanes"), expect.get("modes", 0)))
+    inside = 1 if expect.get("mark_inside") else ran["bodies_inside_solid"]
+    if report.get("insideSolid") != inside:
+        problems.append("%s bodies shown inside solid, the recording has %d" % (report.get("insideSolid"), inside))
     if expect.get("terrain") and not report.get("terrainTriangles"):
         problems.append("no terrain drawn")
 

@@ -222,6 +222,36 @@ std::vector<uint8_t> smallRecording() {
   return bytes;
 }
 
+TEST(Recording, SubmissionModeTimesAndInsideSolidStatesAreKept) {
+  const std::string path = tempPath("modes.bwr");
+  World world(scene("stack10", 4), 1);
+  {
+    RecordingWriter rec(world, path, {}, 1);
+    ContainmentTracker inside(world);
+    for (int f = 0; f < 4; ++f) {
+      world.step();
+      // Frame 2 says the last body is inside solid (as a tracker would): recorded as such.
+      ContainmentReport report = inside.update();
+      if (f == 2) report.bodies.push_back(world.bodies().size() - 1);
+      rec.frame(world, report);
+    }
+    const std::vector<double> update{0.5, 0.25, 0.125, 1}, other{1, 2, 3, 4}, short_{1, 2};
+    rec.submissionMode("per-object mutex", update, other, other, other);
+    EXPECT_THROW(rec.submissionMode("bad", short_, other, other, other), InvalidInput);
+    rec.finish();
+  }
+  const Recording r = readRecording(path);
+  ASSERT_EQ(r.modes.size(), 1u);
+  EXPECT_EQ(r.modes[0].name, "per-object mutex");
+  EXPECT_EQ(r.modes[0].updateMs, (std::vector<float>{0.5f, 0.25f, 0.125f, 1.f}));
+  EXPECT_EQ(r.modes[0].waitMs, (std::vector<float>{1, 2, 3, 4}));
+  for (uint32_t f = 0; f < 4; ++f) {
+    ASSERT_EQ(r.frames[f].ids.back(), world.bodies().size() - 1);
+    EXPECT_EQ(r.frames[f].states.back() == RecordedState::InsideSolid, f == 2) << "frame " << f;
+  }
+  std::filesystem::remove(path);
+}
+
 std::string errorOf(const std::vector<uint8_t>& bytes) {
   try {
     parseRecording(bytes, "x.bwr");
