@@ -343,7 +343,7 @@ function main() {
   }
 
   // Bodies: grid and terrain bodies are groups posed each frame; primitives are instances.
-  const bodyObjects = [];  // per body: {group, materialSlots} or null for primitives
+  const bodyObjects = [];  // per body: {group, meshes, cellBox, lod, bounds, ...}, or null for primitives
   const bodyShapeMatrix = rec.bodies.map((b) => new THREE.Matrix4().compose(
       new THREE.Vector3(...b.shapePos), new THREE.Quaternion(...b.shapeRot), new THREE.Vector3(1, 1, 1)));
   const terrainGroups = [];
@@ -406,7 +406,6 @@ function main() {
     }
     return primitiveMeshes[key];
   }
-  const kindGeometry = [sphere, unitBox, cylinder, null, null, unitBox];
   // Capsule caps: two spheres per capsule.
   const capsuleCaps = 'caps';
 
