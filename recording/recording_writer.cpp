@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <zlib.h>
 
@@ -151,14 +152,44 @@ void RecordingWriter::writeGrid(const World& world, uint32_t g) {
   s.put(name.data(), name.size());
   s.put(grid.brickCount());
   s.put(uint32_t(bricks ? grid.brickCount() : 0));
+  if (mirrors_.size() <= g) mirrors_.resize(g + 1);
+  mirrors_[g] = Mirror{.kept = bricks};
   if (bricks)
     grid.forEachBrick([&](uint32_t id) {
       s.put(id);
       putBrick(s, grid.brick(id));
+      mirrorEdit({g, id, true, grid.brick(id)});
     });
   block(kTagGrid, s);
   writeNodeBoxes(world, g);
   gridsWritten_ = g + 1;
+}
+
+void RecordingWriter::mirrorEdit(const BrickEdit& e) {
+  if (e.grid >= mirrors_.size() || !mirrors_[e.grid].kept) return;
+  Mirror& m = mirrors_[e.grid];
+  if (e.brick >= m.live.size()) {
+    if (!e.placed) return;
+    const size_t size = std::max<size_t>(e.brick + 1, m.live.size() * 3 / 2);
+    m.live.resize(size, 0);
+    m.bricks.resize(size);
+  }
+  m.live[e.brick] = e.placed;
+  if (e.placed) m.bricks[e.brick] = e.value;
+}
+
+void RecordingWriter::diffWithMirror(const World& world, uint32_t g, std::vector<BrickEdit>& out) {
+  if (g >= gridsWritten_ || !mirrors_[g].kept) return;  // a grid made this frame is written as the frame leaves it
+  const BrickGrid& grid = world.grid(g);
+  Mirror& m = mirrors_[g];
+  const size_t first = out.size();
+  const auto same = [](const Brick& a, const Brick& b) { return std::memcmp(&a, &b, sizeof(Brick)) == 0; };
+  for (uint32_t id = 0; id < m.live.size(); ++id)
+    if (m.live[id] && (!grid.hasBrick(id) || !same(grid.brick(id), m.bricks[id]))) out.push_back({g, id, false, m.bricks[id]});
+  grid.forEachBrick([&](uint32_t id) {
+    if (id >= m.live.size() || !m.live[id] || !same(grid.brick(id), m.bricks[id])) out.push_back({g, id, true, grid.brick(id)});
+  });
+  for (size_t k = first; k < out.size(); ++k) mirrorEdit(out[k]);
 }
 
 void RecordingWriter::writeNodeBoxes(const World& world, uint32_t g) {
@@ -279,10 +310,15 @@ void RecordingWriter::frame(const World& world, const ContainmentReport& inside)
   const StepStats& stats = world.lastStats();
   const EditLog& log = world.lastEdits();
   ByteSink& s = scratch_;
-  if (!log.bricks.empty()) {
+  // The logged edits, then what edits through World::editGrid() changed (found by comparing
+  // those grids with their mirrors once the logged edits are in).
+  edits_.assign(log.bricks.begin(), log.bricks.end());
+  for (const BrickEdit& e : edits_) mirrorEdit(e);
+  for (uint32_t g : log.wholeGrids) diffWithMirror(world, g, edits_);
+  if (!edits_.empty()) {
     s.bytes.clear();
-    s.put(uint32_t(log.bricks.size()));
-    for (const BrickEdit& e : log.bricks) {
+    s.put(uint32_t(edits_.size()));
+    for (const BrickEdit& e : edits_) {
       s.put(e.grid);
       s.put(e.brick);
       s.put(uint8_t(e.placed));
@@ -311,10 +347,10 @@ void RecordingWriter::frame(const World& world, const ContainmentReport& inside)
 
   const BodyStore& b = world.bodies();
   states_.assign(b.size(), uint8_t(RecordedState::Awake));
-  for (uint32_t i = 0; i < b.size(); ++i) {
+  for (uint32_t i = 0; i < b.size(); ++i)
     if (world.asleep(i)) states_[i] = uint8_t(RecordedState::Asleep);
-    if (world.depenetration(i)) states_[i] = uint8_t(RecordedState::PushedOut);
-  }
+  for (const Depenetration& d : world.depenetrating())
+    if (d.body < b.size()) states_[d.body] = uint8_t(RecordedState::PushedOut);
   for (uint32_t body : inside.bodies)
     if (body < b.size()) states_[body] = uint8_t(RecordedState::InsideSolid);
   float stages[kStages];

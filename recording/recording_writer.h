@@ -70,6 +70,11 @@ class RecordingWriter {
   /// mesh reads one voxel into each neighbour); updates the kept hashes.
   std::vector<uint64_t> changedChunks(const World& world, uint32_t t);
   void putPose(ByteSink& s, const Vec3d& position, const Quatf& rotation) const;
+  /// Keeps grid `g`'s mirror (below) up to date with one edit.
+  void mirrorEdit(const BrickEdit& e);
+  /// The edits that turn grid `g`'s mirror into the grid (removals, then placements), appended
+  /// to `out`; the mirror then equals the grid. For grids edited through World::editGrid().
+  void diffWithMirror(const World& world, uint32_t g, std::vector<BrickEdit>& out);
 
   std::string path_;
   void* file_ = nullptr;  // gzFile
@@ -81,6 +86,16 @@ class RecordingWriter {
   // Per terrain: a hash of each stored chunk's voxels, by chunk key (what changedChunks compares).
   std::vector<std::unordered_map<uint64_t, uint64_t>> chunkHashes_;
   std::vector<uint8_t> states_;  // per body, this frame's RecordedState (scratch)
+  // Per grid recorded brick by brick, its bricks as a reader of the recording has them so far,
+  // by brick id (live: 1). An edit through World::editGrid() is not logged brick by brick: the
+  // grid is compared with its mirror to record what changed. Empty for grids recorded as boxes.
+  struct Mirror {
+    bool kept = false;  // the grid is recorded brick by brick
+    std::vector<Brick> bricks;
+    std::vector<uint8_t> live;
+  };
+  std::vector<Mirror> mirrors_;
+  std::vector<BrickEdit> edits_;  // the frame's EDIT entries (scratch)
   ByteSink scratch_;
 };
 

@@ -8,8 +8,10 @@
 /// each built from its grid as the frame leaves it. Replaying `bricks` in order on a copy of the
 /// grids taken before the step (a placement adds `value` under id `brick`, a removal drops the
 /// brick with that id) gives the grids after it; ids freed by a removal may be used again by a
-/// later placement of the same frame. Edits made through World::editGrid() are not in the log
-/// (the world does not see them brick by brick).
+/// later placement of the same frame. The log of a step starts with World::removeBricks()' edits
+/// and splits made since the previous step. Edits made through World::editGrid() are not in
+/// `bricks` (the world does not see them brick by brick): `wholeGrids` names the grids handed
+/// out since the previous step, which a mirror takes again whole (after `bricks`).
 #include <cstdint>
 #include <vector>
 
@@ -33,9 +35,11 @@ struct SplitEdit {
 struct EditLog {
   std::vector<BrickEdit> bricks;
   std::vector<SplitEdit> splits;
+  std::vector<uint32_t> wholeGrids;  ///< grids edited through World::editGrid(), ascending, each once
   void clear() {
     bricks.clear();
     splits.clear();
+    wholeGrids.clear();
   }
 };
 

@@ -97,6 +97,7 @@ BrickGrid& World::editGrid(uint32_t index) {
   editedGrids_.push_back(index);
   wholeGridEdits_.push_back(index);  // where it is edited is not known: everything on it wakes
   if (links_[index]) linksStale_[index] = 1;
+  if (recordingEdits_) betweenSteps_.wholeGrids.push_back(index);
   return *grids_[index];
 }
 
@@ -125,7 +126,11 @@ World::RemovalResult World::removeBricks(uint32_t index, std::span<const uint32_
   stats_.splits = stats_.debrisBricks = 0;
   splitDetachedParts();
   RemovalResult r{stats_.splits, stats_.debrisBricks, 0.0};
-  stats_ = kept;  // the last step's figures stay as they were
+  stats_ = kept;
+  if (recordingEdits_) {  // the next step's log starts with these
+    betweenSteps_.bricks.insert(betweenSteps_.bricks.end(), editLog_.bricks.begin(), editLog_.bricks.end());
+    betweenSteps_.splits.insert(betweenSteps_.splits.end(), editLog_.splits.begin(), editLog_.splits.end());
+  }  // the last step's figures stay as they were
   r.ms = msSince(t);
   return r;
 }
@@ -337,6 +342,7 @@ EditLoad::Hooks World::editHooks() {
 void World::recordEdits(bool on) {
   recordingEdits_ = on;
   editLog_.clear();
+  betweenSteps_.clear();
 }
 
 void World::splitDetachedParts() {
@@ -465,6 +471,11 @@ void World::refreshGridBodyMass(uint32_t body) {
 void World::runEdits() {
   ProfileZone z(profiler_, "edits", kEditStage, true);
   editLog_.clear();
+  if (recordingEdits_) {  // what removeBricks() and editGrid() did since the last step comes first
+    std::swap(editLog_, betweenSteps_);
+    std::sort(editLog_.wholeGrids.begin(), editLog_.wholeGrids.end());
+    editLog_.wholeGrids.erase(std::unique(editLog_.wholeGrids.begin(), editLog_.wholeGrids.end()), editLog_.wholeGrids.end());
+  }
   refreshStaleLinks();
   if (!editLoad_.empty()) {
     const auto load = Clock::now();

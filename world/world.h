@@ -165,6 +165,8 @@ class World {
   uint32_t startedInSolid() const { return startedInSolid_; }
   /// Of those, the ones still on their way out (kinematic until they arrive).
   uint32_t depenetratingCount() const { return uint32_t(depenetrating_.size()); }
+  /// Those bodies and their push-outs, in no particular order (a recording marks them in one pass).
+  std::span<const Depenetration> depenetrating() const { return depenetrating_; }
   /// Dynamic bodies currently asleep.
   uint32_t sleepingCount() const { return sleep_.count(); }
   /// Whether body `body` (< bodies().size()) is a dynamic body asleep.
@@ -219,7 +221,9 @@ class World {
   void applyFrameEdits();
   /// Whether steps record their edits brick by brick into lastEdits() (off: nothing kept).
   void recordEdits(bool on);
-  /// The last step's, applyFrameEdits()' or removeBricks()' edits, when recordEdits(true) (edit_log.h).
+  /// The last step's, applyFrameEdits()' or removeBricks()' edits, when recordEdits(true)
+  /// (edit_log.h). A step's log starts with what removeBricks() and editGrid() did since the
+  /// previous step, so a mirror that reads the log after each step misses nothing.
   const EditLog& lastEdits() const { return editLog_; }
 
  private:
@@ -351,6 +355,7 @@ class World {
   std::vector<uint32_t> wholeGridEdits_;  // of those, the ones handed out by editGrid()
   BodyBoxIndex editedBoxes_;           // the edit load's bricks of this frame, in the world
   EditLog editLog_;                    // the frame's edits brick by brick (when recordingEdits_)
+  EditLog betweenSteps_;               // removeBricks() and editGrid() since the last step: the next log starts with them
   bool recordingEdits_ = false;
   EditLoad editLoad_;                  // the scene's edits, applied at the start of each step
   // Grids that split (GridDescription::split): per grid, its connectivity (null: does not split),

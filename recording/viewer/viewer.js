@@ -746,25 +746,51 @@ function main() {
   }
   // Level of detail and culling, per cell of a grid drawn brick by brick: a cell out of the view
   // is not drawn; a cell (or a one-cell grid) whose bounds cover less than ~4% of the view's
-  // height is drawn as its box (one-cell grids: their NODE level 3 boxes, at most 512).
+  // height is drawn as its box (one-cell grids: their NODE level 3 boxes, at most 512). Then a
+  // brick budget: the cells left are drawn brick by brick largest on screen first until their
+  // bricks reach `budget`, the rest as boxes. The budget is #budget=N, else it follows the frame
+  // rate while playing (adaptBudget).
   const lodSphere = new THREE.Sphere(), frustum = new THREE.Frustum(), viewProjection = new THREE.Matrix4();
   const cellMatrix = new THREE.Matrix4();
+  const BUDGET_MIN = 20000, BUDGET_MAX = 8000000;
+  const fixedBudget = new URLSearchParams(location.hash.slice(1)).get('budget');
+  let budget = fixedBudget ? Math.max(0, Number(fixedBudget)) : 500000;
+  let budgetLimited = false;  // the last choice left cells as boxes for the budget alone
+  const cellBricks = (grid, c) => grid.used[c][0] + grid.used[c][1] + grid.used[c][2] + grid.used[c][3];
   function chooseDetail() {
     camera.updateMatrixWorld();
     frustum.setFromMatrix(viewProjection.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse));
     const tanHalf = Math.tan((camera.fov * Math.PI) / 360);
-    let coarseCells = 0, culledCells = 0, gridsAsBoxes = 0;
+    const chosen = [], fine = [];
     bodyObjects.forEach((obj) => {
       if (!obj || obj.grid === undefined || !obj.group.visible) return;
       const grid = grids[obj.grid];
       if (!grid.source.hasBricks) return;
-      const state = grid.spheres.map((sphere, c) => {
-        if (!sphere) return 'fine';
-        lodSphere.copy(sphere).applyMatrix4(obj.group.matrix);
-        if (!frustum.intersectsSphere(lodSphere)) return 'culled';
-        const distance = Math.max(lodSphere.center.distanceTo(camera.position), 1e-6);
-        return lodSphere.radius / (distance * tanHalf) < 0.04 ? 'coarse' : 'fine';
+      const entry = { obj, grid, state: [] };
+      grid.spheres.forEach((sphere, c) => {
+        let size = Infinity;  // no bounds (an empty grid): drawn as it is
+        if (sphere) {
+          lodSphere.copy(sphere).applyMatrix4(obj.group.matrix);
+          if (!frustum.intersectsSphere(lodSphere)) { entry.state.push('culled'); return; }
+          size = lodSphere.radius / (Math.max(lodSphere.center.distanceTo(camera.position), 1e-6) * tanHalf);
+          if (size < 0.04) { entry.state.push('coarse'); return; }
+        }
+        entry.state.push('fine');
+        fine.push({ entry, c, size, bricks: cellBricks(grid, c) });
       });
+      chosen.push(entry);
+    });
+    fine.sort((a, b) => b.size - a.size);
+    let inFull = 0;
+    budgetLimited = false;
+    for (const f of fine) {
+      // A cell with no box to stand in for it (a one-cell grid without NODE boxes) is drawn anyway.
+      const standIn = f.entry.grid.cellBoxes || f.entry.grid.source.levels.length;
+      if (inFull + f.bricks > budget && standIn && f.size !== Infinity) { f.entry.state[f.c] = 'coarse'; budgetLimited = true; }
+      else inFull += f.bricks;
+    }
+    let coarseCells = 0, culledCells = 0, gridsAsBoxes = 0;
+    for (const { obj, grid, state } of chosen) {
       for (const m of obj.meshes) m.visible = state[m.userData.cell] === 'fine';
       if (obj.cellBox) {
         const boxes = grid.cellBoxes, a = obj.cellBox.instanceMatrix.array;
@@ -787,14 +813,29 @@ function main() {
       if (obj.lod) obj.lod.visible = state[0] === 'coarse' && !obj.cellBox;
       gridsAsBoxes += !obj.cellBox && state[0] === 'coarse' && !!obj.lod;
       for (const st of state) { coarseCells += st === 'coarse'; culledCells += st === 'culled'; }
-    });
+    }
     report.gridsAsBoxes = gridsAsBoxes;
     report.cellsAsBoxes = coarseCells;
     report.cellsCulled = culledCells;
+    report.bricksInFull = inFull;
+    report.brickBudget = budget;
   }
+  // While playing, the budget follows the frame rate: the average time between frames above
+  // 50 ms (under 20 fps) shrinks it, under 25 ms grows it again while it is what holds cells back.
+  let frameInterval = 0;
+  function adaptBudget(ms) {
+    if (fixedBudget) return;
+    frameInterval = frameInterval ? 0.8 * frameInterval + 0.2 * ms : ms;
+    if (frameInterval > 50) budget = Math.max(BUDGET_MIN, Math.round(budget * 0.8));
+    else if (frameInterval < 25 && budgetLimited) budget = Math.min(BUDGET_MAX, Math.round(budget * 1.2));
+  }
+  const status = document.getElementById('status');
   function draw() {
     chooseDetail();
     renderer.render(scene, camera);
+    status.textContent = rec.bodies.length + ' bodies, ' + rec.grids.length + ' grids, ' + report.bricksDrawn + ' bricks, ' +
+        report.bricksInFull + ' of them drawn brick by brick (budget ' + budget + (fixedBudget ? '' : ', follows the frame rate') +
+        '); drag to orbit, wheel to zoom, right-drag to pan';
   }
   controls.addEventListener('change', draw);
   window.addEventListener('resize', resize);
@@ -809,6 +850,7 @@ function main() {
   function tick(t) {
     if (!playing) return;
     carry += (t - last) / 1000;
+    adaptBudget(t - last);
     last = t;
     const steps = Math.floor(carry / head.timestep);
     if (steps > 0) {
@@ -862,8 +904,6 @@ function main() {
     }
     report.drawMs = (performance.now() - t0) / 20;
   }
-  document.getElementById('status').textContent = rec.bodies.length + ' bodies, ' + rec.grids.length + ' grids, ' +
-      report.bricksDrawn + ' bricks drawn; drag to orbit, wheel to zoom, right-drag to pan';
   report.ready = true;
   writeReport();
 }

@@ -5,7 +5,8 @@ For each scene: `brickworld run SCENE --record` then `brickworld view`, then Chr
 (Debian's chromium-headless-shell, which setup.sh installs) loads the page at its last frame:
 the page must report no errors and no console errors, the frame count and the body count of the
 run, every body drawn (and every brick, for grids recorded brick by brick), and a screenshot
-whose 3D view is not blank.
+whose 3D view is not blank; with a small brick budget (#budget=N) no more than N bricks drawn one
+by one and more cells drawn as boxes.
 
 usage: browser_check.py BRICKWORLD WORK_DIR
 """
@@ -20,7 +21,7 @@ import zlib
 
 # scene, frames, extra run options, what the last frame must show
 SCENES = [
-    ("crates_on_grid", 90, ["--record-contacts", "--submission", "all"], {"contacts": True, "bricks": True, "modes": 3}),
+    ("crates_on_grid", 90, ["--record-contacts", "--submission", "all"], {"contacts": True, "bricks": True, "modes": 3, "budget": 5000}),
     ("demolition", 120, [], {"bricks": True, "mark_inside": True}),
     ("quarry", 200, [], {"terrain": True}),
     ("city_rain", 60, [], {}),  # the city (1M bricks) drawn as its OctoBVH boxes
@@ -41,12 +42,12 @@ def chromium():
     fail("no chromium-headless-shell on PATH: install Debian's chromium-headless-shell (bash setup.sh does)")
 
 
-def browse(page, extra, timeout=300):
+def browse(page, extra, address="frame=last&contacts", timeout=300):
     # swiftshader: WebGL on the CPU (no GPU on CI machines); a virtual time budget lets the
     # page's scripts finish before the DOM is dumped or the picture taken.
     cmd = [chromium(), "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--enable-logging=stderr",
            "--v=0", "--window-size=%d,%d" % (WIDTH, HEIGHT), "--virtual-time-budget=60000"] + extra + \
-          ["file://" + os.path.abspath(page) + "#frame=last&contacts"]
+          ["file://" + os.path.abspath(page) + "#" + address]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
 
 
@@ -110,6 +111,16 @@ def mark_inside_solid(recording):
     open(recording, "wb").write(bytes(data))
 
 
+def page_report(scene, page, address="frame=last&contacts"):
+    """The page's #bw-report and the console messages Chromium logged while it loaded."""
+    dom = browse(page, ["--dump-dom"], address)
+    match = re.search(r'<pre id="bw-report">([^<]*)</pre>', dom.stdout)
+    if not match:
+        fail("%s: the page wrote no report (Chromium exit %d):\n%s" % (scene, dom.returncode, dom.stderr[-3000:]))
+    report = json.loads(match.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+    return report, [l for l in dom.stderr.splitlines() if ":CONSOLE(" in l or "Uncaught" in l]
+
+
 def check_scene(brickworld, work, scene, frames, options, expect):
     recording = os.path.join(work, scene + ".bwr")
     page = os.path.join(work, scene + ".html")
@@ -124,12 +135,7 @@ def check_scene(brickworld, work, scene, frames, options, expect):
     if view.returncode != 0:
         fail("%s: brickworld view failed:\n%s" % (scene, view.stderr))
 
-    dom = browse(page, ["--dump-dom"])
-    match = re.search(r'<pre id="bw-report">([^<]*)</pre>', dom.stdout)
-    if not match:
-        fail("%s: the page wrote no report (Chromium exit %d):\n%s" % (scene, dom.returncode, dom.stderr[-3000:]))
-    report = json.loads(match.group(1).replace("&quot;", '"').replace("&amp;", "&"))
-    console = [l for l in dom.stderr.splitlines() if ":CONSOLE(" in l or "Uncaught" in l]
+    report, console = page_report(scene, page)
     print("%s: %s" % (scene, json.dumps(report)))
     problems = []
     if not report.get("ready"):
@@ -157,6 +163,16 @@ def check_scene(brickworld, work, scene, frames, options, expect):
         problems.append("%s bodies shown inside solid, the recording has %d" % (report.get("insideSolid"), inside))
     if expect.get("terrain") and not report.get("terrainTriangles"):
         problems.append("no terrain drawn")
+    if not report.get("bricksInFull") and ran["bricks"] and expect.get("bricks"):
+        problems.append("no brick drawn brick by brick")
+    if expect.get("budget"):
+        # A brick budget below what the view holds: fewer bricks drawn one by one, more cells as boxes.
+        small, _ = page_report(scene, page, "frame=last&budget=%d" % expect["budget"])
+        print("%s with budget %d: %s" % (scene, expect["budget"], json.dumps(small)))
+        if small.get("bricksInFull", 0) > expect["budget"] or small.get("brickBudget") != expect["budget"]:
+            problems.append("budget %d: %s bricks drawn brick by brick" % (expect["budget"], small.get("bricksInFull")))
+        if small.get("cellsAsBoxes", 0) <= report.get("cellsAsBoxes", 0):
+            problems.append("budget %d: %s cells as boxes, %s without it" % (expect["budget"], small.get("cellsAsBoxes"), report.get("cellsAsBoxes")))
 
     shot = os.path.join(work, scene + ".png")
     if os.path.exists(shot):

@@ -159,6 +159,79 @@ TEST(Recording, EditsReplayedOnTheRecordedGridsGiveTheRunsGridsThroughSplits) {
   std::filesystem::remove(path);
 }
 
+// Edits a game makes between steps: World::editGrid() (seen by the world only as "this grid
+// changed") and World::removeBricks() (which may split parts off). Both worlds get the same edits;
+// the recorded one must replay to the run's grids and its hash must equal the other's.
+TEST(Recording, EditsThroughEditGridAndRemoveBricksBetweenStepsAreRecorded) {
+  const SceneDescription s = scene("demolition", 60);
+  const std::string path = tempPath("between_steps.bwr");
+  World world(s, 2);
+  World plain(s, 2);
+  uint32_t g = 0;  // the grid with the most bricks
+  for (uint32_t k = 1; k < world.gridCount(); ++k)
+    if (world.grid(k).brickCount() > world.grid(g).brickCount()) g = k;
+  std::mt19937 rng(20261125);
+  const auto someLive = [&](const BrickGrid& grid) {
+    std::vector<uint32_t> ids;
+    grid.forEachBrick([&](uint32_t id) { ids.push_back(id); });
+    return ids[std::uniform_int_distribution<size_t>(0, ids.size() - 1)(rng)];
+  };
+  uint32_t splits = 0, handEdits = 0, removals = 0;
+  {
+    RecordingWriter rec(world, path, {}, 2);
+    ContainmentTracker inside(world);
+    for (uint32_t f = 0; f < s.settings.frames; ++f) {
+      if (f % 10 == 3) {
+        // Remove two bricks, put one back 100 m up (a loose brick: a later removal splits it
+        // off), and one back where it was (its id may be used again: seen as a change).
+        const uint32_t a = someLive(world.grid(g)), b = someLive(world.grid(g));
+        for (World* w : {&world, &plain}) {  // the same ids in both: the worlds are equal
+          BrickGrid& grid = w->editGrid(g);
+          const Brick ba = grid.brick(a), bb = grid.brick(b);
+          grid.removeBrick(a);
+          if (b != a) grid.removeBrick(b);
+          Brick up = ba;
+          up.position.z() += 100.f;
+          grid.placeBrick(up);
+          if (b != a) grid.placeBrick(bb);
+        }
+        handEdits += 4;
+      }
+      if (f % 10 == 6) {
+        const uint32_t ids[2] = {someLive(world.grid(g)), someLive(world.grid(g))};
+        const uint32_t n = ids[0] == ids[1] ? 1 : 2;
+        splits += world.removeBricks(g, std::span<const uint32_t>(ids, n)).parts;
+        plain.removeBricks(g, std::span<const uint32_t>(ids, n));
+        removals += n;
+      }
+      world.step();
+      plain.step();
+      splits += world.lastStats().splits;
+      rec.frame(world, inside.update());
+    }
+    rec.finish();
+  }
+  ASSERT_GT(handEdits + removals, 0u);
+  EXPECT_GT(splits, 0u) << "the loose bricks placed 100 m up must split off at a removal";
+  EXPECT_EQ(world.stateHash(), plain.stateHash()) << "recording changed the simulation";
+  const Recording r = readRecording(path);
+  uint32_t recordedSplits = 0;
+  for (const RecordedFrame& f : r.frames) recordedSplits += f.splits;
+  EXPECT_EQ(recordedSplits, splits) << "removeBricks()' splits belong to the next frame's recording";
+  ASSERT_EQ(r.grids.size(), world.gridCount());
+  const auto grids = replayGrids(r);
+  for (uint32_t k = 0; k < world.gridCount(); ++k) {
+    std::map<uint32_t, Brick> live;
+    world.grid(k).forEachBrick([&](uint32_t id) { live[id] = world.grid(k).brick(id); });
+    ASSERT_EQ(grids[k].size(), live.size()) << "grid " << k << " (" << world.gridName(k) << ")";
+    for (const auto& [id, b] : live) {
+      ASSERT_TRUE(grids[k].count(id)) << "grid " << k << " brick " << id;
+      EXPECT_TRUE(sameBrick(grids[k].at(id), b)) << "grid " << k << " brick " << id;
+    }
+  }
+  std::filesystem::remove(path);
+}
+
 TEST(Recording, TerrainChunksFollowTheCarvesAndSlabsBecomeGridBodies) {
   const SceneDescription s = scene("quarry", 200);
   const std::string path = tempPath("quarry.bwr");
