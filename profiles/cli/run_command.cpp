@@ -183,6 +183,10 @@ CommandRegistration reg{"run", "Headless stress run: a scene (default crates_on_
   cmd.add_option("--record-bricks", scene->recordBricks,
                  "scene: grids with more bricks than this are recorded as their OctoBVH boxes (default 300000)")
       ->check(CLI::Range(0u, 100'000'000u));
+  cmd.add_option("--record-depth", scene->recordDepth,
+                 "scene: levels of OctoBVH boxes recorded per grid, level k at most 8^k boxes (default 5; a grid recorded as boxes "
+                 "is drawn by its deepest level)")
+      ->check(CLI::Range(1, 7));
   cmd.add_option("--engine", scene->engine,
                  "scene: brickworld (default); bullet (as a Bullet expert sets it up: chunk compounds, CCD) or bullet-naive "
                  "(one compound per grid); both (brickworld and bullet) or all: same initial state, ratios and accuracy")

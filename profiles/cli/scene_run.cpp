@@ -274,6 +274,7 @@ int runScene(const SceneRunOptions& o) {
     ro.contacts = o.recordContacts;
     ro.gzip = o.recordGzip;
     ro.maxGridBricks = o.recordBricks;
+    ro.nodeLevels = o.recordDepth;
     recording = std::make_unique<RecordingWriter>(world, o.recordPath, ro, o.threads);
   }
   const auto tRun = Clock::now();

@@ -19,6 +19,7 @@ struct SceneRunOptions {
   bool recordContacts = false;  ///< the recording carries every frame's contacts
   bool recordGzip = false;      ///< the recording is one gzip stream
   uint32_t recordBricks = 300'000;  ///< grids above this many bricks are recorded as their OctoBVH boxes
+  int recordDepth = 5;              ///< levels of OctoBVH boxes recorded per grid (RecordingOptions::nodeLevels)
   bool json = false;
   bool progress = true;
   /// brickworld; bullet (Bullet as an expert sets it up) or bullet-naive (one compound per grid);

@@ -459,6 +459,9 @@ function main() {
     o.textContent = (g.name || 'grid ' + gi) + ' (' + g.brickCount + ' bricks)';
     nodeSelect.appendChild(o);
   });
+  nodeDepth.max = rec.grids.reduce((most, g) => Math.max(most, g.levels.length), 1);  // the run's --record-depth
+  nodeDepth.value = Math.min(3, Number(nodeDepth.max));
+  document.getElementById('node-depth-label').textContent = nodeDepth.value;
   const nodeMaterial = new THREE.MeshBasicMaterial({ color: 0x00ff88, wireframe: true, transparent: true, opacity: 0.5 });
   let nodeOverlay = null;
   function updateNodeOverlay() {

@@ -23,5 +23,6 @@ expect_failure("expected a Brickadia save (.brs) or a MagicaVoxel model (.vox), 
 # naming a missing or foreign file.
 expect_failure("--record: cannot write /nonexistent/dir/r.bwr" run city_rain --frames 1 --record /nonexistent/dir/r.bwr)
 expect_failure("--record records brickworld's run" run stack10 --frames 1 --engine bullet --record r.bwr)
+expect_failure("--record-depth: Value 9 not in range 1 to 7" run city_rain --frames 1 --record r.bwr --record-depth 9)
 expect_failure("recording /nonexistent/r.bwr: cannot open it" view /nonexistent/r.bwr -o r.html)
 expect_failure("not a brickworld recording" view ${SCENES}/stack10.json -o r.html)

@@ -232,6 +232,32 @@ TEST(Recording, EditsThroughEditGridAndRemoveBricksBetweenStepsAreRecorded) {
   std::filesystem::remove(path);
 }
 
+TEST(Recording, NodeBoxesAreRecordedToTheChosenDepth) {
+  const SceneDescription s = scene("crates_on_grid", 1);
+  for (const int levels : {1, 2, 6}) {
+    const std::string path = tempPath("depth.bwr");
+    World world(s, 1);
+    {
+      RecordingOptions o;
+      o.nodeLevels = levels;
+      RecordingWriter rec(world, path, o, 1);
+      world.step();
+      rec.frame(world, {});
+      rec.finish();
+    }
+    const Recording r = readRecording(path);
+    ASSERT_FALSE(r.grids.empty());
+    ASSERT_EQ(r.grids[0].nodeLevels.size(), size_t(levels));
+    size_t most = 1;
+    for (int k = 0; k < levels; ++k) {
+      most *= 8;
+      EXPECT_LE(r.grids[0].nodeLevels[k].size(), most) << "level " << k + 1;
+      EXPECT_GT(r.grids[0].nodeLevels[k].size(), k ? r.grids[0].nodeLevels[k - 1].size() : 0u) << "level " << k + 1;
+    }
+    std::filesystem::remove(path);
+  }
+}
+
 TEST(Recording, TerrainChunksFollowTheCarvesAndSlabsBecomeGridBodies) {
   const SceneDescription s = scene("quarry", 200);
   const std::string path = tempPath("quarry.bwr");
