@@ -99,21 +99,30 @@ double WorkSpan::speedupBound(int threads) const {
 
 namespace {
 struct StageTime {
+  int32_t stage = 0;
   double work = 0, longest = 0, serial = 0;  // ms: all zones, the longest zone, the serial zones
 };
-using StageTimes = std::map<int32_t, StageTime>;
+// A frame has a few dozen stages at most and its zones come stage by stage: a flat list searched
+// from its end beats a map (the whole run's work/span is taken after every `run`).
+using StageTimes = std::vector<StageTime>;
 
 void addZone(StageTimes& stages, const ProfileEvent& e) {
   const double ms = double(e.endNs - e.beginNs) * 1e-6;
-  StageTime& s = stages[e.stage];
+  auto it = std::find_if(stages.rbegin(), stages.rend(), [&](const StageTime& s) { return s.stage == e.stage; });
+  StageTime& s = it != stages.rend() ? *it : stages.emplace_back(StageTime{e.stage});
   s.work += ms;
   s.longest = std::max(s.longest, ms);
   if (e.serial) s.serial += ms;
 }
 
-WorkSpan toWorkSpan(const StageTimes& stages) {
+WorkSpan toWorkSpan(StageTimes& stages) {
+  std::sort(stages.begin(), stages.end(), [](const StageTime& a, const StageTime& b) { return a.stage < b.stage; });
   WorkSpan ws;
-  for (const auto& [stage, s] : stages) {
+  ws.stageWorkMs.reserve(stages.size());
+  ws.stageSpanMs.reserve(stages.size());
+  ws.stageIds.reserve(stages.size());
+  for (const StageTime& s : stages) {
+    const int32_t stage = s.stage;
     const double span = std::max(s.longest, s.serial);
     ws.workMs += s.work;
     ws.spanMs += span;
@@ -136,7 +145,7 @@ std::vector<WorkSpan> Profiler::workSpans(uint32_t frames) const {
   }
   std::vector<WorkSpan> out;
   out.reserve(frames);
-  for (const StageTimes& stages : perFrame) out.push_back(toWorkSpan(stages));
+  for (StageTimes& stages : perFrame) out.push_back(toWorkSpan(stages));
   return out;
 }
 
