@@ -113,6 +113,20 @@ std::vector<std::map<uint32_t, Brick>> replayGrids(const Recording& r) {
 
 bool sameBrick(const Brick& a, const Brick& b) { return std::memcmp(&a, &b, sizeof(Brick)) == 0; }
 
+// The recording's edits replayed on its grids give every grid of the world as it is now.
+void expectReplayGivesTheWorldsGrids(const Recording& r, const World& world) {
+  const auto grids = replayGrids(r);
+  for (uint32_t g = 0; g < world.gridCount(); ++g) {
+    std::map<uint32_t, Brick> live;
+    world.grid(g).forEachBrick([&](uint32_t id) { live[id] = world.grid(g).brick(id); });
+    ASSERT_EQ(grids[g].size(), live.size()) << "grid " << g << " (" << world.gridName(g) << ")";
+    for (const auto& [id, b] : live) {
+      ASSERT_TRUE(grids[g].count(id)) << "grid " << g << " brick " << id;
+      EXPECT_TRUE(sameBrick(grids[g].at(id), b)) << "grid " << g << " brick " << id;
+    }
+  }
+}
+
 TEST(Recording, EditsReplayedOnTheRecordedGridsGiveTheRunsGridsThroughSplits) {
   const SceneDescription s = scene("demolition", 120);
   const std::string path = tempPath("demolition.bwr");
@@ -140,16 +154,7 @@ TEST(Recording, EditsReplayedOnTheRecordedGridsGiveTheRunsGridsThroughSplits) {
   EXPECT_GE(recordedEdits, edited);  // the load's edits, then the bricks parts took along
   ASSERT_EQ(r.grids.size(), world.gridCount());
   ASSERT_EQ(r.bodies.size(), world.bodies().size());
-  const auto grids = replayGrids(r);
-  for (uint32_t g = 0; g < world.gridCount(); ++g) {
-    std::map<uint32_t, Brick> live;
-    world.grid(g).forEachBrick([&](uint32_t id) { live[id] = world.grid(g).brick(id); });
-    ASSERT_EQ(grids[g].size(), live.size()) << "grid " << g << " (" << world.gridName(g) << ")";
-    for (const auto& [id, b] : live) {
-      ASSERT_TRUE(grids[g].count(id)) << "grid " << g << " brick " << id;
-      EXPECT_TRUE(sameBrick(grids[g].at(id), b)) << "grid " << g << " brick " << id;
-    }
-  }
+  expectReplayGivesTheWorldsGrids(r, world);
   // Bodies made by splits appear in the frame of their split, as dynamic grid bodies.
   for (uint32_t b = 0; b < r.bodies.size(); ++b)
     if (r.bodies[b].frame >= 0) {
@@ -219,16 +224,7 @@ TEST(Recording, EditsThroughEditGridAndRemoveBricksBetweenStepsAreRecorded) {
   for (const RecordedFrame& f : r.frames) recordedSplits += f.splits;
   EXPECT_EQ(recordedSplits, splits) << "removeBricks()' splits belong to the next frame's recording";
   ASSERT_EQ(r.grids.size(), world.gridCount());
-  const auto grids = replayGrids(r);
-  for (uint32_t k = 0; k < world.gridCount(); ++k) {
-    std::map<uint32_t, Brick> live;
-    world.grid(k).forEachBrick([&](uint32_t id) { live[id] = world.grid(k).brick(id); });
-    ASSERT_EQ(grids[k].size(), live.size()) << "grid " << k << " (" << world.gridName(k) << ")";
-    for (const auto& [id, b] : live) {
-      ASSERT_TRUE(grids[k].count(id)) << "grid " << k << " brick " << id;
-      EXPECT_TRUE(sameBrick(grids[k].at(id), b)) << "grid " << k << " brick " << id;
-    }
-  }
+  expectReplayGivesTheWorldsGrids(r, world);
   std::filesystem::remove(path);
 }
 
