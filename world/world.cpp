@@ -126,11 +126,11 @@ World::RemovalResult World::removeBricks(uint32_t index, std::span<const uint32_
   stats_.splits = stats_.debrisBricks = 0;
   splitDetachedParts();
   RemovalResult r{stats_.splits, stats_.debrisBricks, 0.0};
-  stats_ = kept;
+  stats_ = kept;  // the last step's figures stay as they were
   if (recordingEdits_) {  // the next step's log starts with these
     betweenSteps_.bricks.insert(betweenSteps_.bricks.end(), editLog_.bricks.begin(), editLog_.bricks.end());
     betweenSteps_.splits.insert(betweenSteps_.splits.end(), editLog_.splits.begin(), editLog_.splits.end());
-  }  // the last step's figures stay as they were
+  }
   r.ms = msSince(t);
   return r;
 }

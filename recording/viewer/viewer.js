@@ -756,8 +756,10 @@ function main() {
   const lodSphere = new THREE.Sphere(), frustum = new THREE.Frustum(), viewProjection = new THREE.Matrix4();
   const cellMatrix = new THREE.Matrix4();
   const BUDGET_MIN = 20000, BUDGET_MAX = 8000000;
-  const fixedBudget = new URLSearchParams(location.hash.slice(1)).get('budget');
-  let budget = fixedBudget ? Math.max(0, Number(fixedBudget)) : 500000;
+  const budgetText = new URLSearchParams(location.hash.slice(1)).get('budget');
+  const asked = budgetText ? Number(budgetText) : NaN;
+  const fixedBudget = Number.isFinite(asked) && asked >= 0;  // else (absent or not a count) it adapts
+  let budget = fixedBudget ? asked : 500000;
   let budgetLimited = false;  // the last choice left cells as boxes for the budget alone
   const cellBricks = (grid, c) => grid.used[c][0] + grid.used[c][1] + grid.used[c][2] + grid.used[c][3];
   function chooseDetail() {
