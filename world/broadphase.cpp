@@ -28,23 +28,22 @@ SweepAndPrune::~SweepAndPrune() = default;
 SweepAndPrune::SweepAndPrune(SweepAndPrune&&) noexcept = default;
 SweepAndPrune& SweepAndPrune::operator=(SweepAndPrune&&) noexcept = default;
 
-void SweepAndPrune::validate(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic,
-                             const std::vector<uint32_t>* owner) const {
+void validateProxies(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner,
+                     const char* who) {
+  const std::string context(who);
   if (isStatic.size() != bounds.size())
-    throw InvalidInput("SweepAndPrune::update: " + std::to_string(bounds.size()) + " bounds but " +
-                       std::to_string(isStatic.size()) + " static flags");
+    throw InvalidInput(context + ": " + std::to_string(bounds.size()) + " bounds but " + std::to_string(isStatic.size()) + " static flags");
   if (owner && owner->size() != bounds.size())
-    throw InvalidInput("SweepAndPrune::update: " + std::to_string(bounds.size()) + " bounds but " + std::to_string(owner->size()) +
-                       " owners");
+    throw InvalidInput(context + ": " + std::to_string(bounds.size()) + " bounds but " + std::to_string(owner->size()) + " owners");
   for (uint32_t i = 0; i < uint32_t(bounds.size()); ++i) {
     // Checked without building a message per proxy (this runs every substep); the message is
     // made only for the one that fails.
     const WorldAabb& b = bounds[i];
     if (b.min.allFinite() && b.max.allFinite() && (b.min.array() <= b.max.array()).all()) continue;
     const std::string what = "bounds of body " + std::to_string(i);
-    requireFinite(b.min, "SweepAndPrune::update", (what + " min").c_str());
-    requireFinite(b.max, "SweepAndPrune::update", (what + " max").c_str());
-    throw InvalidInput("SweepAndPrune::update: " + what + " are inverted (min > max)");
+    requireFinite(b.min, who, (what + " min").c_str());
+    requireFinite(b.max, who, (what + " max").c_str());
+    throw InvalidInput(context + ": " + what + " are inverted (min > max)");
   }
 }
 
@@ -111,7 +110,7 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
   jobs_ = jobs;
   profiler_ = profiler;
   MaybeZone orderZone(profiler, "broadphase: order", stage);
-  validate(bounds, isStatic, owner);
+  validateProxies(bounds, isStatic, owner, "SweepAndPrune::update");
   const uint32_t n = uint32_t(bounds.size());
   moving_.clear();
   for (uint32_t i = 0; i < n; ++i)

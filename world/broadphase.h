@@ -1,20 +1,20 @@
 #pragma once
-/// Body-level broadphase: which bodies' world bounds overlap.
+/// Body-level broadphase types (bounds, pairs, the input check) and SweepAndPrune, the world's
+/// broadphase until session 17, kept as the reference every frame of IncrementalBroadphase (the
+/// world's now) is checked against in bench_world and the tests, and as a bench row.
 ///
-/// Moving proxies (dynamic and kinematic) sit in a sweep and prune on the axis of largest
-/// spread, the sorted order kept from frame to frame (insertion sort is near-linear when bodies
-/// move a little per step; the first frame, a changed set of moving proxies, or a frame whose
-/// insertion sort would exceed ~8 moves per body sorts in bulk, in parallel: no quadratic
-/// first frame). Static proxies never enter the sweep: they sit in a tree built in bulk
-/// (StaticBoundsTree), rebuilt only when a static box changes, and every moving proxy queries
-/// it. New pairs are found per moving proxy in parallel chunks, each chunk writing its own
-/// list; the lists are joined in chunk order and sorted in parallel.
+/// SweepAndPrune: moving proxies (dynamic and kinematic) sit in a sweep and prune on the axis
+/// of largest spread, the sorted order kept from frame to frame (insertion sort is near-linear
+/// when bodies move a little per step; the first frame, a changed set of moving proxies, or a
+/// frame whose insertion sort would exceed ~8 moves per body sorts in bulk, in parallel: no
+/// quadratic first frame). Static proxies never enter the sweep: they sit in a tree built in
+/// bulk (StaticBoundsTree), rebuilt only when a static box changes, and every moving proxy
+/// queries it. Every pair is found anew every frame, per moving proxy in parallel chunks, each
+/// chunk writing its own list; the lists are joined in chunk order and sorted.
 ///
-/// Why, measured in bench_world Broadphase/* at 1k-1M bodies against Bullet's tuned
-/// btDbvtBroadphase and btAxisSweep3 (profiles/RESULTS.md): first frames 2-8x faster than the
-/// dbvt's from 10k up (no incremental insertion), steady frames 1.7x faster at 1M. But the
-/// dbvt keeps its pairs from frame to frame and wins steady frames at 1k and 10k (2.4x and
-/// 1.6x here): an incremental pair set over fattened boxes is the next step.
+/// Why it was replaced, measured in bench_world Broadphase/* (profiles/RESULTS.md, sessions 7
+/// and 17): it beat Bullet's tuned btDbvtBroadphase on first frames and at 1M, but lost steady
+/// frames at 1k and 10k (2.4x and 1.6x), where the dbvt keeps its pairs between frames.
 ///
 /// Determinism: the output is sorted by (a, b) with a < b, without repeats, and does not depend
 /// on the previous order or on thread count.
@@ -50,6 +50,11 @@ struct BodyPair {
 
 class StaticBoundsTree;
 
+/// Checks a broadphase's input: one static flag (and owner) per proxy, finite bounds with
+/// min <= max. Throws InvalidInput naming `who` and the proxy.
+void validateProxies(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner,
+                     const char* who);
+
 class SweepAndPrune {
  public:
   /// Profiler stages update() uses, from its `stage` argument on.
@@ -78,7 +83,6 @@ class SweepAndPrune {
   uint64_t staticBuilds() const { return staticBuilds_; }
 
  private:
-  void validate(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner) const;
   bool staticSetChanged(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic);
   bool insertionSort(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic);
   void sortInBulk(const std::vector<WorldAabb>& bounds, int stage);

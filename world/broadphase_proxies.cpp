@@ -54,7 +54,7 @@ void World::findPairs() {
   }
   proxies.reset();
   // Proxies of one grid pair with a body once: the broadphase's pairs are of owners.
-  broadphase_.update(proxyBounds_, proxyStatic_, pairs_, &jobs_, &profiler_, stage_ + 14, &proxyBody_);
+  broadphase_.update(proxyBounds_, proxyStatic_, pairs_, &jobs_, &profiler_, stage_ + kBroadphaseStage, &proxyBody_);
 }
 
 }  // namespace bw

@@ -36,7 +36,7 @@
 #include "jobs/job_system.h"
 #include "jobs/profiler.h"
 #include "world/body_store.h"
-#include "world/broadphase.h"
+#include "world/incremental_broadphase.h"
 #include "world/containment.h"
 #include "world/contact_solver.h"
 #include "world/depenetration.h"
@@ -289,13 +289,13 @@ class World {
   // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
   // solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first), sleeping's two
   // passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11: union,
-  // 12: flatten; 13 unused), the sweep and prune (kBroadphaseStage, its kStages), terrain pairs
+  // 12: flatten; 13 unused), the broadphase (kBroadphaseStage, its kStages), terrain pairs
   // (kTerrainStage: select, plan, cut, pieces, finish, apply), the pair cache and the other steps between
   // (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded, stored after
   // the solve and after the relax, counters; then + 8 .. + 13 contacts grouped by island).
   // Every piece of a substep's work is in one of them: work/span sees the whole step.
   static constexpr int kBroadphaseStage = 14;
-  static constexpr int kTerrainStage = kBroadphaseStage + SweepAndPrune::kStages;
+  static constexpr int kTerrainStage = kBroadphaseStage + IncrementalBroadphase::kStages;
   static constexpr int kContactStepsStage = kTerrainStage + 6;
   static constexpr int kStagesPerSubstep = kContactStepsStage + 14;
 
@@ -324,7 +324,7 @@ class World {
   std::vector<WorldAabb> bounds_;
   std::vector<uint8_t> isStatic_;
   std::vector<float> reach_;  // per body: speed + spin x radius (m/s), from computeBounds()
-  SweepAndPrune broadphase_;
+  IncrementalBroadphase broadphase_;
   // Broadphase proxies: a large static grid enters the sweep as the boxes covering its bricks a
   // few OctoBVH levels down (BrickGrid::coverBoxes, at most tuning::kCoverBoxes) instead of one box around it all, so a body
   // above a city's streets pairs with the city only near a building; other bodies as their box.

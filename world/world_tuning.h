@@ -34,6 +34,24 @@ inline constexpr uint32_t kMinIslandGrain = 64;
 /// Body bounds grow by this (m) beyond how far the body can move in one frame, so resting
 /// bodies keep their pairs through small motions and pairs are not found one frame late.
 inline constexpr double kBroadphaseMargin = 0.02;
+/// A moving proxy's fat box (IncrementalBroadphase): its bounds grown by kFatMargin (m) and
+/// stretched ahead by kFatPrediction updates of its last displacement (at most
+/// kFatPredictionLimit m per axis, so a body that jumps does not get a huge box). While its
+/// bounds stay inside, its pairs are kept without a query. Stretching by the displacement leaves
+/// resting bodies (a pile's jitter) with small boxes, so few pairs that never touch are kept.
+/// Chosen by bench_world Broadphase/* (profiles/RESULTS.md, session 17): bodies moving 0.02-0.08
+/// m a frame leave 10-12% of their boxes a frame at 2 updates ahead, 1-2% at 16.
+inline constexpr double kFatMargin = 0.1;
+inline constexpr double kFatPrediction = 16.0;
+inline constexpr double kFatPredictionLimit = 4.0;
+/// When more than this share of the moving proxies left their fat boxes in one frame, their
+/// tree is built again in bulk (in parallel) instead of moving each leaf (serial).
+inline constexpr double kFatRebuildShare = 0.1;
+/// Fewest proxies per job of the broadphase's per-proxy stages (a containment test, or a tree
+/// query of a moved proxy) and fewest pairs per job of its pair filters.
+inline constexpr uint32_t kMinProxyGrain = 256;
+inline constexpr uint32_t kMinQueryGrain = 32;
+inline constexpr uint32_t kMinPairGrain = 1024;
 /// Static grids of at least this many bricks enter the broadphase as at most kCoverBoxes boxes
 /// covering their bricks (BrickGrid::coverBoxes). 512 measured against 256 and 1024 on
 /// crates_on_grid, city_rain and lighthouse: 1024 slows the sweep more than it saves in pairs,

@@ -93,6 +93,7 @@
 #include "collision/core/seeded_random.h"
 #include "collision/index/octobvh.h"
 #include "world/broadphase.h"
+#include "world/incremental_broadphase.h"
 #include "world/bullet_baseline.h"
 #include "world/scene_file.h"
 #include "world/world.h"
@@ -239,7 +240,7 @@ void runBroadphase(benchmark::State& state, const char* name) {
     fail("frame 0: " + std::to_string(pairs.size()) + " pairs, SweepAndPrune has " + std::to_string(ref.first.size()));
     return;
   }
-  double found = 0, tests = 0, cache = 0, totalMs = 0;
+  double found = 0, tests = 0, cache = 0, moved = 0, totalMs = 0;
   bool ok = true;
   for (auto _ : state) {
     b.step();
@@ -251,6 +252,7 @@ void runBroadphase(benchmark::State& state, const char* name) {
     found += double(pairs.size());
     tests += method.tests();
     cache += method.cachePairs();
+    if constexpr (requires { method.moved(); }) moved += method.moved();
     if (pairs.size() != ref.counts[b.frame]) {
       fail("frame " + std::to_string(b.frame) + ": " + std::to_string(pairs.size()) + " pairs, SweepAndPrune has " +
            std::to_string(ref.counts[b.frame]));
@@ -267,14 +269,25 @@ void runBroadphase(benchmark::State& state, const char* name) {
   state.counters["pairs"] = found / iters;
   state.counters["tests"] = tests / iters;
   state.counters["cache_pairs"] = cache / iters;
+  if constexpr (requires(Method m) { m.moved(); }) state.counters["moved"] = moved / iters;
   state.counters["first_frame_ms"] = firstMs;
   broadphaseFigures()[std::string(name) + "/" + std::to_string(n)] = {totalMs / iters, firstMs, found / iters};
 }
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Ours: SweepAndPrune on JobSystem(1), so the parallel code path (chunks, the job-system sample
-// sorts) runs, on one thread.
+// Ours: IncrementalBroadphase (the world's) on JobSystem(1), so the parallel code path (chunks,
+// the job-system sample sorts, the tree's bulk build) runs, on one thread.
+struct OurIncremental {
+  IncrementalBroadphase bp;
+  void first(const Bodies& b, std::vector<BodyPair>& pairs) { bp.update(b.bounds, b.isStatic, pairs, &oneThread()); }
+  void frame(const Bodies& b, std::vector<BodyPair>& pairs) { bp.update(b.bounds, b.isStatic, pairs, &oneThread()); }
+  double tests() const { return double(bp.lastTests()); }
+  double cachePairs() const { return double(bp.fatPairs()); }
+  double moved() const { return double(bp.lastMoved()); }
+};
+
+// The previous world broadphase: SweepAndPrune on JobSystem(1), every pair found every frame.
 struct OurSweepAndPrune {
   SweepAndPrune sap;
   void first(const Bodies& b, std::vector<BodyPair>& pairs) { sap.update(b.bounds, b.isStatic, pairs, &oneThread()); }
@@ -466,11 +479,11 @@ void printBroadphaseRatios() {
   const auto& m = broadphaseFigures();
   const auto key = [](const char* method, uint32_t n) { return std::string(method) + '/' + std::to_string(n); };
   for (uint32_t n : kBroadphaseCounts) {
-    if (!m.count(key("SweepAndPrune", n))) continue;
-    const BroadphaseFigures& ours = m.at(key("SweepAndPrune", n));
-    std::printf("broadphase, %u moving bodies (%.0f pairs): SweepAndPrune %.3f ms a frame, first frame %.1f ms", n, ours.pairs,
+    if (!m.count(key("IncrementalBroadphase", n))) continue;
+    const BroadphaseFigures& ours = m.at(key("IncrementalBroadphase", n));
+    std::printf("broadphase, %u moving bodies (%.0f pairs): IncrementalBroadphase %.3f ms a frame, first frame %.1f ms", n, ours.pairs,
                 ours.frameMs, ours.firstMs);
-    for (const char* other : {"btDbvtBroadphase", "btAxisSweep3", "OctoBVH", "BruteForce"}) {
+    for (const char* other : {"SweepAndPrune", "btDbvtBroadphase", "btAxisSweep3", "OctoBVH", "BruteForce"}) {
       if (!m.count(key(other, n))) continue;
       const BroadphaseFigures& f = m.at(key(other, n));
       std::printf("; %s %.3f ms (%.1fx), first %.1f ms (%.1fx)", other, f.frameMs, f.frameMs / std::max(ours.frameMs, 1e-9), f.firstMs,
@@ -634,6 +647,8 @@ int main(int argc, char** argv) {
   const auto add = [](const std::string& name, uint32_t n, void (*fn)(benchmark::State&)) {
     benchmark::RegisterBenchmark(name.c_str(), fn)->Arg(n)->Iterations(framesFor(n))->UseManualTime()->Unit(benchmark::kMillisecond);
   };
+  for (uint32_t n : kBroadphaseCounts)
+    add("Broadphase/IncrementalBroadphase", n, [](benchmark::State& s) { runBroadphase<OurIncremental>(s, "IncrementalBroadphase"); });
   for (uint32_t n : kBroadphaseCounts)
     add("Broadphase/SweepAndPrune", n, [](benchmark::State& s) { runBroadphase<OurSweepAndPrune>(s, "SweepAndPrune"); });
   for (uint32_t n : kBroadphaseCounts)

@@ -1,10 +1,12 @@
-// The sweep and prune with its sorted copy and sweep in chunks on a JobSystem: the same pairs and
-// the same test count as the serial sweep and brute force, for 1, 2, 4 and 16 threads, on dense
-// clusters, huge static boxes and bodies that jump (the bulk sort). Labelled `concurrency`.
+// The broadphases with their stages in chunks on a JobSystem: the same pairs and the same test
+// count as their serial runs, for 1, 2, 4 and 16 threads, on dense clusters, huge static boxes and
+// bodies that jump (the sweep's bulk sort; the incremental broadphase's bulk tree build) or creep
+// (its leaves moved one by one). Labelled `concurrency`.
 #include <gtest/gtest.h>
 
 #include "collision/core/seeded_random.h"
 #include "world/broadphase.h"
+#include "world/incremental_broadphase.h"
 
 namespace bw {
 namespace {
@@ -40,6 +42,52 @@ TEST(SweepAndPrune, ChunkedOnAnyThreadCountEqualsSerial) {
     }
     for (uint32_t i = frame % 2; i < n; i += 2) place(i);  // half jump: the bulk sort
   }
+}
+
+TEST(IncrementalBroadphase, ChunkedOnAnyThreadCountEqualsSerial) {
+  SeededRandom r(9);
+  const uint32_t n = 20000;  // several chunks in every stage, tree ranges built in parallel
+  std::vector<WorldAabb> b(n);
+  std::vector<uint8_t> st(n, 0);
+  auto place = [&](uint32_t i) {
+    const bool cluster = i % 3 == 0;
+    const Vec3d c = cluster ? Vec3d(r.uniform(0, 10), r.uniform(0, 10), r.uniform(0, 10))
+                            : Vec3d(r.uniform(-400, 400), r.uniform(-400, 400), r.uniform(0, 50));
+    const Vec3d h = i % 500 == 0 ? Vec3d(100, 100, 3) : Vec3d::Constant(r.logUniform(0.1, 2));
+    b[i] = {c - h, c + h};
+  };
+  for (uint32_t i = 0; i < n; ++i) {
+    place(i);
+    st[i] = i % 500 == 0 || i % 11 == 0;
+  }
+  IncrementalBroadphase serial;
+  std::vector<IncrementalBroadphase> parallel(4);
+  const int threadCounts[] = {1, 2, 4, 16};
+  for (int frame = 0; frame < 6; ++frame) {
+    std::vector<BodyPair> expected;
+    serial.update(b, st, expected);
+    ASSERT_GT(expected.size(), 5000u);
+    for (int k = 0; k < 4; ++k) {
+      JobSystem jobs(threadCounts[k]);
+      Profiler profiler;
+      std::vector<BodyPair> pairs;
+      parallel[k].update(b, st, pairs, &jobs, &profiler, 0);
+      ASSERT_EQ(pairs, expected) << threadCounts[k] << " threads, frame " << frame;
+      EXPECT_EQ(parallel[k].lastTests(), serial.lastTests());
+      EXPECT_EQ(parallel[k].movingBuilds(), serial.movingBuilds());
+    }
+    if (frame % 2 == 0) {
+      for (uint32_t i = frame % 4 / 2; i < n; i += 2)  // half jump: the tree built in bulk
+        if (!st[i]) place(i);
+    } else {
+      for (uint32_t i = 0; i < n; i += 97) {  // a few creep past their boxes: leaves moved
+        b[i].min.x() += 0.3;
+        b[i].max.x() += 0.3;
+      }
+      st[frame * 13] = !st[frame * 13];  // a body stops (static) or starts moving
+    }
+  }
+  EXPECT_GE(serial.movingBuilds(), 3u);
 }
 
 }  // namespace
