@@ -196,24 +196,30 @@ uint32_t DynamicBoundsTree::rotateUp(uint32_t a, uint32_t up) {
 
 // ------------------------------------------------------------------------------- bulk build
 
+// Spreads the low 21 bits of v so that two zero bits follow each (bit i moves to bit 3i).
+uint64_t DynamicBoundsTree::spread(uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffull;
+  v = (v | v << 16) & 0x1f0000ff0000ffull;
+  v = (v | v << 8) & 0x100f00f00f00f00full;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+  v = (v | v << 2) & 0x1249249249249249ull;
+  return v;
+}
+
 void DynamicBoundsTree::split(const Range& r, Range& left, Range& right) {
-  // note: centres compared as min + max (twice the centre): the same order, one add fewer.
-  const auto centre = [](const Item& i, int a) { return i.box.min[a] + i.box.max[a]; };
-  Vec3d lo = items_[r.begin].box.min + items_[r.begin].box.max, hi = lo;
-  for (uint32_t p = r.begin + 1; p < r.end; ++p) {
-    const Vec3d c = items_[p].box.min + items_[p].box.max;
-    lo = lo.cwiseMin(c);
-    hi = hi.cwiseMax(c);
+  // Where the range's first and last codes first differ (the octree cell boundary between its
+  // halves); a range of equal codes splits in the middle.
+  const uint64_t first = codes_[r.begin].first, last = codes_[r.end - 1].first;
+  uint32_t mid;
+  if (first == last) {
+    mid = r.begin + (r.end - r.begin) / 2;
+  } else {
+    const int bit = 63 - __builtin_clzll(first ^ last);
+    const uint64_t above = last >> bit << bit;  // the first code on the upper side
+    mid = uint32_t(std::lower_bound(codes_.begin() + r.begin, codes_.begin() + r.end, std::pair<uint64_t, uint32_t>{above, 0}) -
+                   codes_.begin());
   }
-  int axis;
-  (hi - lo).maxCoeff(&axis);
-  const uint32_t mid = r.begin + (r.end - r.begin) / 2;
-  // Ties broken by item index: a strict total order, so the split is a pure function of the
-  // range's items.
-  std::nth_element(items_.begin() + r.begin, items_.begin() + mid, items_.begin() + r.end, [&](const Item& a, const Item& b) {
-    const double ca = centre(a, axis), cb = centre(b, axis);
-    return ca < cb || (ca == cb && a.item < b.item);
-  });
   // A range of k leaves owns the k - 1 inner nodes from its own: the left range the next
   // (mid - begin - 1), the right range those after them.
   const uint32_t leftCount = mid - r.begin, rightCount = r.end - mid;
@@ -225,17 +231,8 @@ void DynamicBoundsTree::split(const Range& r, Range& left, Range& right) {
   node.child2 = right.node;
 }
 
-void DynamicBoundsTree::finishLeaf(uint32_t p) {
-  Node& leaf = nodes_[buildLeaf(p)];
-  leaf.box = items_[p].box;
-  leaf.child1 = kNull;
-  leaf.child2 = (*buildIds_)[items_[p].item];
-  leaf.height = 0;
-}
-
 void DynamicBoundsTree::buildSubtree(const Range& r) {
   if (r.end - r.begin == 1) {
-    finishLeaf(r.begin);
     nodes_[r.node].parent = r.parent;
     return;
   }
@@ -254,52 +251,203 @@ void DynamicBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::ve
   clear();
   leafOf.resize(n);
   if (n == 0) return;
-  buildIds_ = &ids;
   buildCount_ = n;
   nodes_.assign(2 * size_t(n) - 1, kFreeNode);
-  items_.resize(n);
-  const auto forEach = [&](uint32_t count, uint32_t grain, int at, const char* zone, const auto& body) {
+  codes_.resize(n);
+  const uint32_t itemGrain = std::max<uint32_t>(1024, (n + 63) / 64);
+  const uint32_t chunks = JobSystem::chunkCount(0, n, itemGrain);
+  const auto forChunks = [&](uint32_t count, uint32_t grain, int at, const char* zone, const auto& body) {
     if (!jobs) {
       const MaybeZone z(profiler, zone, at);
-      for (uint32_t k = 0; k < count; ++k) body(k);
+      for (uint32_t begin = 0; begin < count; begin += grain) body(begin, std::min(count, begin + grain));
       return;
     }
     jobs->parallelFor(0, count, grain, [&](uint32_t begin, uint32_t end) {
       const MaybeZone z(profiler, zone, at);
-      for (uint32_t k = begin; k < end; ++k) body(k);
+      body(begin, end);
     });
   };
-  const uint32_t itemGrain = std::max<uint32_t>(1024, (n + 63) / 64);
-  forEach(n, itemGrain, stage, "dynamic tree: items", [&](uint32_t k) {
-    items_[k] = {boxes[k], k};
+  // 1. The centres' bounds (per chunk, joined in chunk order), then each item's Morton code on
+  //    a 2^21 lattice over them; sorted by (code, item): near in space, near in the order.
+  chunkLo_.resize(chunks);
+  chunkHi_.resize(chunks);
+  forChunks(n, itemGrain, stage, "dynamic tree: codes", [&](uint32_t begin, uint32_t end) {
+    Vec3d lo = boxes[begin].min + boxes[begin].max, hi = lo;
+    for (uint32_t k = begin + 1; k < end; ++k) {
+      const Vec3d c = boxes[k].min + boxes[k].max;  // twice the centre: the same order
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
+    }
+    chunkLo_[begin / itemGrain] = lo;
+    chunkHi_[begin / itemGrain] = hi;
+  });
+  Vec3d lo = chunkLo_[0], hi = chunkHi_[0];
+  for (uint32_t c = 1; c < chunks; ++c) {
+    lo = lo.cwiseMin(chunkLo_[c]);
+    hi = hi.cwiseMax(chunkHi_[c]);
+  }
+  const double cells = double((1u << 21) - 1);
+  const Vec3d scale = (hi - lo).unaryExpr([&](double e) { return e > 0 ? cells / e : 0.0; });
+  forChunks(n, itemGrain, stage + 1, "dynamic tree: codes", [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) {
+      const Vec3d q = ((boxes[k].min + boxes[k].max - lo).cwiseProduct(scale)).cwiseMax(0.0).cwiseMin(cells);
+      codes_[k] = {spread(uint64_t(q.x())) << 2 | spread(uint64_t(q.y())) << 1 | spread(uint64_t(q.z())), k};
+    }
+  });
+  if (jobs) {
+    sorter_.sort(codes_, false, *jobs, profiler, "dynamic tree: sort codes", stage + 2);
+  } else {
+    std::sort(codes_.begin(), codes_.end());
+  }
+  // 2. Leaves in that order (the boxes gathered once), inner nodes over ranges split where the
+  //    codes first differ: the ranges above kSubtreeLeaves level by level, the rest whole, one
+  //    job each, then the top ranges' boxes, children before parents.
+  forChunks(n, itemGrain, stage + 6, "dynamic tree: leaves", [&](uint32_t begin, uint32_t end) {
+    for (uint32_t p = begin; p < end; ++p) {
+      const uint32_t item = codes_[p].second;
+      nodes_[buildLeaf(p)] = {boxes[item], kNull, kNull, ids[item], 0};
+      leafOf[item] = buildLeaf(p);
+    }
   });
   root_ = n == 1 ? buildLeaf(0) : 0;
-  // Ranges above kSubtreeLeaves split level by level, a level's ranges in parallel; the rest
-  // are built whole, one job each; the top ranges' boxes last, children before parents.
   level_.assign(1, Range{0, n, root_, kNull});
   whole_.clear();
   top_.clear();
-  int at = stage + 1;
-  while (!level_.empty()) {
-    next_.clear();
-    for (const Range& r : level_) (r.end - r.begin > kSubtreeLeaves ? next_ : whole_).push_back(r);
-    level_.swap(next_);
-    if (level_.empty()) break;
-    children_.resize(2 * level_.size());
-    forEach(uint32_t(level_.size()), 1, std::min(at, stage + kBuildStages - 3), "dynamic tree: split level",
-            [&](uint32_t k) { split(level_[k], children_[2 * k], children_[2 * k + 1]); });
-    if (at < stage + kBuildStages - 3) ++at;
-    top_.insert(top_.end(), level_.begin(), level_.end());
-    level_.assign(children_.begin(), children_.end());
-  }
-  forEach(uint32_t(whole_.size()), 1, stage + kBuildStages - 2, "dynamic tree: subtrees", [&](uint32_t k) { buildSubtree(whole_[k]); });
   {
-    const MaybeZone z(profiler, "dynamic tree: top boxes", stage + kBuildStages - 1);
+    const MaybeZone z(profiler, "dynamic tree: top ranges", stage + 7);
+    while (!level_.empty()) {
+      next_.clear();
+      for (const Range& r : level_) {
+        if (r.end - r.begin <= kSubtreeLeaves) {
+          whole_.push_back(r);
+          continue;
+        }
+        Range left, right;
+        split(r, left, right);
+        top_.push_back(r);
+        next_.push_back(left);
+        next_.push_back(right);
+      }
+      level_.swap(next_);
+    }
+  }
+  forChunks(uint32_t(whole_.size()), 1, stage + 8, "dynamic tree: subtrees", [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) buildSubtree(whole_[k]);
+  });
+  {
+    const MaybeZone z(profiler, "dynamic tree: top boxes", stage + 9);
     for (auto it = top_.rbegin(); it != top_.rend(); ++it) fix(it->node);
   }
-  forEach(n, itemGrain, stage + kBuildStages - 1, "dynamic tree: leaves", [&](uint32_t p) { leafOf[items_[p].item] = buildLeaf(p); });
   leaves_ = n;
-  buildIds_ = nullptr;
+}
+
+// ------------------------------------------------------------------------- the tree against itself
+
+template <class Emit>
+void DynamicBoundsTree::crossPairs(uint32_t a, uint32_t b, std::vector<Task>& stack, Emit& emit) const {
+  stack.clear();
+  stack.push_back({a, b});
+  while (!stack.empty()) {
+    const Task t = stack.back();
+    stack.pop_back();
+    const Node& x = nodes_[t.a];
+    const Node& y = nodes_[t.b];
+    if (!x.box.overlaps(y.box)) continue;
+    if (x.child1 == kNull && y.child1 == kNull) {
+      emit(x.child2, y.child2);
+      continue;
+    }
+    // Open the larger side (a leaf never opens).
+    if (y.child1 != kNull && (x.child1 == kNull || halfArea(y.box) > halfArea(x.box))) {
+      stack.push_back({t.a, y.child2});
+      stack.push_back({t.a, y.child1});
+    } else {
+      stack.push_back({x.child2, t.b});
+      stack.push_back({x.child1, t.b});
+    }
+  }
+}
+
+template <class Emit>
+void DynamicBoundsTree::selfTask(uint32_t n, std::vector<Task>& stack, Emit& emit) const {
+  if (isLeaf(n)) return;
+  selfTask(nodes_[n].child1, stack, emit);
+  selfTask(nodes_[n].child2, stack, emit);
+  crossPairs(nodes_[n].child1, nodes_[n].child2, stack, emit);
+}
+
+void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, JobSystem* jobs, Profiler* profiler, int stage) {
+  out.clear();
+  if (root_ == kNull) return;
+  // The top of the traversal, breadth first, until there are enough tasks to share: a subtree
+  // against itself becomes its children against themselves and each other; two subtrees
+  // against each other become the larger one's children against the other (dropped when the
+  // boxes miss). The tasks' order depends only on the tree.
+  constexpr uint32_t kTasks = 256;
+  constexpr int kRounds = 10;
+  tasks_.assign(1, Task{root_, kNull});
+  for (int round = 0; round < kRounds && tasks_.size() < kTasks; ++round) {
+    nextTasks_.clear();
+    for (const Task& t : tasks_) {
+      if (t.b == kNull) {
+        if (isLeaf(t.a)) continue;
+        const Node& node = nodes_[t.a];
+        nextTasks_.push_back({node.child1, kNull});
+        nextTasks_.push_back({node.child2, kNull});
+        nextTasks_.push_back({node.child1, node.child2});
+        continue;
+      }
+      const Node& x = nodes_[t.a];
+      const Node& y = nodes_[t.b];
+      if (!x.box.overlaps(y.box)) continue;
+      if (x.child1 == kNull && y.child1 == kNull) {
+        nextTasks_.push_back(t);
+      } else if (y.child1 != kNull && (x.child1 == kNull || halfArea(y.box) > halfArea(x.box))) {
+        nextTasks_.push_back({t.a, y.child1});
+        nextTasks_.push_back({t.a, y.child2});
+      } else {
+        nextTasks_.push_back({x.child1, t.b});
+        nextTasks_.push_back({x.child2, t.b});
+      }
+    }
+    tasks_.swap(nextTasks_);
+  }
+  const uint32_t count = uint32_t(tasks_.size());
+  if (taskPairs_.size() < count) {
+    taskPairs_.resize(count);
+    taskStacks_.resize(count);
+  }
+  const auto run = [&](uint32_t k) {
+    std::vector<BodyPair>& pairs = taskPairs_[k];
+    pairs.clear();
+    auto emit = [&](uint32_t p, uint32_t q) { pairs.push_back(p < q ? BodyPair{p, q} : BodyPair{q, p}); };
+    const Task& t = tasks_[k];
+    if (t.b == kNull) {
+      selfTask(t.a, taskStacks_[k], emit);
+    } else {
+      crossPairs(t.a, t.b, taskStacks_[k], emit);
+    }
+  };
+  if (jobs) {
+    jobs->parallelFor(0, count, 1, [&](uint32_t begin, uint32_t end) {
+      const MaybeZone z(profiler, "dynamic tree: pairs", stage);
+      for (uint32_t k = begin; k < end; ++k) run(k);
+    });
+  } else {
+    for (uint32_t k = 0; k < count; ++k) run(k);
+  }
+  {
+    const MaybeZone z(profiler, "dynamic tree: join pairs", stage + 1);
+    taskOffset_.assign(count + 1, 0);
+    for (uint32_t k = 0; k < count; ++k) taskOffset_[k + 1] = taskOffset_[k] + taskPairs_[k].size();
+    out.resize(taskOffset_[count]);
+    for (uint32_t k = 0; k < count; ++k) std::copy(taskPairs_[k].begin(), taskPairs_[k].end(), out.begin() + taskOffset_[k]);
+  }
+  if (jobs) {
+    pairSorter_.sort(out, false, *jobs, profiler, "dynamic tree: sort pairs", stage + 2);
+  } else {
+    std::sort(out.begin(), out.end());
+  }
 }
 
 void DynamicBoundsTree::leafIds(std::vector<uint32_t>& out) const {

@@ -39,7 +39,7 @@ namespace bw {
 class IncrementalBroadphase {
  public:
   /// Profiler stages update() uses, from its `stage` argument on.
-  static constexpr int kStages = 16 + DynamicBoundsTree::kBuildStages;
+  static constexpr int kStages = 20 + DynamicBoundsTree::kBuildStages + DynamicBoundsTree::kSelfPairStages;
 
   IncrementalBroadphase();
   ~IncrementalBroadphase();
@@ -85,10 +85,10 @@ class IncrementalBroadphase {
   void gather(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner);
   bool staticSetChanged(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner);
   void fatten(const std::vector<WorldAabb>& bounds);
-  void editTree(bool staticChanged);
+  bool editTree(bool staticChanged);
   bool moveLeaves();
-  void findNewPairs(bool staticChanged);
-  void keepPairs(bool staticChanged);
+  void findNewPairs(bool staticChanged, bool bulk);
+  void keepPairs(bool staticChanged, bool bulk);
   void tightPairs(const std::vector<WorldAabb>& bounds, std::vector<BodyPair>& pairs);
   // Concatenates per-chunk lists in chunk order into `out`, in parallel.
   template <class T>
