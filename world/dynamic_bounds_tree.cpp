@@ -331,7 +331,8 @@ void DynamicBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::ve
       level_.swap(next_);
     }
   }
-  forChunks(uint32_t(whole_.size()), 1, stage + 8, "dynamic tree: subtrees", [&](uint32_t begin, uint32_t end) {
+  const uint32_t subtrees = uint32_t(whole_.size());
+  forChunks(subtrees, std::max<uint32_t>(1, (subtrees + 63) / 64), stage + 8, "dynamic tree: subtrees", [&](uint32_t begin, uint32_t end) {
     for (uint32_t k = begin; k < end; ++k) buildSubtree(whole_[k]);
   });
   {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "collision/core/errors.h"
+#include "jobs/parallel_merge.h"
 #include "world/static_bounds_tree.h"
 #include "world/world_tuning.h"
 
@@ -33,10 +34,11 @@ bool contains(const WorldAabb& outer, const WorldAabb& inner) {
 
 // Stage offsets within update()'s range.
 enum Stage : int {
-  kGather = 0,
-  kFat = 1,
-  kTreeEdits = 2,
-  kTreeBuild = 3,  // .. + DynamicBoundsTree::kBuildStages - 1
+  kGather = 0,  // .. + 1: the proxies scanned, the keys written
+  kStatics = 2,
+  kFat = 3,
+  kTreeEdits = 4,
+  kTreeBuild = 5,  // .. + DynamicBoundsTree::kBuildStages - 1
   kOrder = kTreeBuild + DynamicBoundsTree::kBuildStages,
   kSelf,  // .. + DynamicBoundsTree::kSelfPairStages - 1
   kQueries = kSelf + DynamicBoundsTree::kSelfPairStages,
@@ -44,8 +46,8 @@ enum Stage : int {
   kSortNew,  // .. + 7: the moving pairs', then the static pairs' sort
   kKeep = kSortNew + 8,
   kJoinKept,
-  kMerge,
-  kTight,
+  kMerge,  // .. + 1
+  kTight = kMerge + 2,
   kJoinTight,
   kMergeOut,
   kEnd,
@@ -79,24 +81,73 @@ void IncrementalBroadphase::join(std::vector<std::vector<T>>& chunks, uint32_t c
   forChunks(count, 1, stage, zone, [&](uint32_t c, uint32_t) { std::copy(chunks[c].begin(), chunks[c].end(), out.begin() + chunkOffset_[c]); });
 }
 
-// The moving proxies' keys this frame (ascending), each key's proxy; owners with two moving
-// proxies refused before anything that lasts is changed (the frame stamp is new every call).
+// The moving proxies' keys this frame (ascending) and each key's proxy, in parallel chunks;
+// bad bounds, owners over the limit and owners with two moving proxies are refused before
+// anything that lasts is changed (the frame stamp is new every call).
 void IncrementalBroadphase::gather(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic,
                                    const std::vector<uint32_t>* owner) {
+  const uint32_t n = uint32_t(bounds.size());
+  if (isStatic.size() != n || (owner && owner->size() != n)) validateProxies(bounds, isStatic, owner, "IncrementalBroadphase::update");
   ++frame_;
-  keys_.clear();
-  // Per-key arrays sized once for the largest key (growing them key by key copied them dozens
-  // of times on a first frame of a million proxies).
-  uint32_t largest = 0;
-  for (uint32_t i = 0; i < uint32_t(bounds.size()); ++i) {
-    if (isStatic[i]) continue;
-    const uint32_t key = owner ? (*owner)[i] : i;
-    if (key >= kMaxOwner)
-      throw InvalidInput("IncrementalBroadphase::update: owner " + std::to_string(key) + " of proxy " + std::to_string(i) +
-                         " is over the limit of " + std::to_string(kMaxOwner) + " owners");
-    largest = std::max(largest, key);
+  const uint32_t grain = tuning::grainFor(n, tuning::kMinProxyGrain);
+  const uint32_t chunks = JobSystem::chunkCount(0, n, grain);
+  if (chunkKeys_.size() < chunks) {
+    chunkKeys_.resize(chunks);
+    chunkStatics_.resize(chunks);
   }
-  if (largest >= seen_.size()) {
+  chunkScan_.assign(chunks, ChunkScan{});
+  forChunks(n, grain, stage_ + kGather, "broadphase: gather", [&](uint32_t begin, uint32_t end) {
+    ChunkScan& scan = chunkScan_[begin / grain];
+    std::vector<std::pair<uint32_t, uint32_t>>& keys = chunkKeys_[begin / grain];
+    std::vector<uint32_t>& statics = chunkStatics_[begin / grain];
+    keys.clear();
+    statics.clear();
+    for (uint32_t i = begin; i < end; ++i) {
+      const WorldAabb& b = bounds[i];
+      scan.bad |= !(b.min.allFinite() && b.max.allFinite() && (b.min.array() <= b.max.array()).all());
+      if (isStatic[i]) {
+        statics.push_back(i);
+        continue;
+      }
+      const uint32_t key = owner ? (*owner)[i] : i;
+      scan.largest = std::max(scan.largest, key);
+      scan.ascending &= keys.empty() || keys.back().first < key;
+      keys.push_back({key, i});
+    }
+  });
+  uint32_t largest = 0;
+  bool ascending = true;
+  size_t count = 0;
+  for (uint32_t c = 0; c < chunks; ++c) {
+    if (chunkScan_[c].bad) validateProxies(bounds, isStatic, owner, "IncrementalBroadphase::update");  // throws, naming the proxy
+    if (chunkKeys_[c].empty()) continue;
+    ascending = ascending && chunkScan_[c].ascending && (count == 0 || largest < chunkKeys_[c].front().first);
+    largest = std::max(largest, chunkScan_[c].largest);
+    count += chunkKeys_[c].size();
+  }
+  if (largest >= kMaxOwner) {
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t key = owner ? (*owner)[i] : i;
+      if (!isStatic[i] && key >= kMaxOwner)
+        throw InvalidInput("IncrementalBroadphase::update: owner " + std::to_string(key) + " of proxy " + std::to_string(i) +
+                           " is over the limit of " + std::to_string(kMaxOwner) + " owners");
+    }
+  }
+  if (!ascending) {
+    // Owners out of order (never in the world, whose proxies follow its bodies): sorted, and
+    // an owner listed twice refused.
+    sortedKeys_.clear();
+    for (uint32_t c = 0; c < chunks; ++c) sortedKeys_.insert(sortedKeys_.end(), chunkKeys_[c].begin(), chunkKeys_[c].end());
+    std::sort(sortedKeys_.begin(), sortedKeys_.end());
+    for (size_t k = 1; k < sortedKeys_.size(); ++k)
+      if (sortedKeys_[k].first == sortedKeys_[k - 1].first)
+        throw InvalidInput("IncrementalBroadphase::update: owner " + std::to_string(sortedKeys_[k].first) + " has two moving proxies (" +
+                           std::to_string(sortedKeys_[k - 1].second) + " and " + std::to_string(sortedKeys_[k].second) + ")");
+    chunkKeys_[0].swap(sortedKeys_);
+    for (uint32_t c = 1; c < chunks; ++c) chunkKeys_[c].clear();
+  }
+  // Checked: from here on the state changes.
+  if (largest >= seen_.size() && count > 0) {
     const size_t size = std::max<size_t>(largest + 1, seen_.size() * 3 / 2);
     proxy_.resize(size, kNone);
     seen_.resize(size, 0);
@@ -105,33 +156,42 @@ void IncrementalBroadphase::gather(const std::vector<WorldAabb>& bounds, const s
     centre_.resize(size, Vec3d::Zero());
     moved_.resize(size, 0);
   }
-  bool ascending = true;
-  for (uint32_t i = 0; i < uint32_t(bounds.size()); ++i) {
-    if (isStatic[i]) continue;
-    const uint32_t key = owner ? (*owner)[i] : i;
-    if (seen_[key] == frame_)
-      throw InvalidInput("IncrementalBroadphase::update: owner " + std::to_string(key) + " has two moving proxies (" +
-                         std::to_string(proxy_[key]) + " and " + std::to_string(i) + ")");
-    seen_[key] = frame_;
-    proxy_[key] = i;
-    ascending = ascending && (keys_.empty() || keys_.back() < key);
-    keys_.push_back(key);
+  keys_.resize(count);
+  chunkOffset_.assign(chunks + 1, 0);
+  staticStart_.assign(chunks + 1, 0);
+  for (uint32_t c = 0; c < chunks; ++c) {
+    chunkOffset_[c + 1] = chunkOffset_[c] + chunkKeys_[c].size();
+    staticStart_[c + 1] = staticStart_[c] + uint32_t(chunkStatics_[c].size());
   }
-  if (!ascending) std::sort(keys_.begin(), keys_.end());
+  // The keys written, and the static proxies compared with those the static tree holds (ids,
+  // owners and boxes, bit for bit), in the same chunks.
+  const bool sameCount = staticStart_[chunks] == staticIds_.size() && staticBuilds_ > 0;
+  forChunks(chunks, 1, stage_ + kGather + 1, "broadphase: keys", [&](uint32_t c, uint32_t) {
+    size_t at = chunkOffset_[c];
+    for (const auto& [key, proxy] : chunkKeys_[c]) {
+      keys_[at++] = key;
+      seen_[key] = frame_;
+      proxy_[key] = proxy;
+    }
+    bool changed = !sameCount;
+    for (uint32_t k = 0, slot = staticStart_[c]; !changed && k < chunkStatics_[c].size(); ++k, ++slot) {
+      const uint32_t i = chunkStatics_[c][k];
+      changed = staticIds_[slot] != i || std::memcmp(&bounds[i], &staticBoxes_[slot], sizeof(WorldAabb)) != 0 ||
+                staticOwner_[slot] != (owner ? (*owner)[i] : i);
+    }
+    chunkScan_[c].staticChanged = changed;
+  });
 }
 
-// The static proxies now, against those the tree holds: ids, owners and boxes, bit for bit.
-bool IncrementalBroadphase::staticSetChanged(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic,
-                                             const std::vector<uint32_t>* owner) {
-  staticScratch_.clear();
-  for (uint32_t i = 0; i < uint32_t(bounds.size()); ++i)
-    if (isStatic[i]) staticScratch_.push_back(i);
-  bool changed = staticBuilds_ == 0 || staticScratch_ != staticIds_;
-  for (size_t s = 0; !changed && s < staticIds_.size(); ++s)
-    changed = std::memcmp(&bounds[staticIds_[s]], &staticBoxes_[s], sizeof(WorldAabb)) != 0 ||
-              staticOwner_[s] != (owner ? (*owner)[staticIds_[s]] : staticIds_[s]);
+// The static tree built again when the static proxies changed (gather() compared them).
+bool IncrementalBroadphase::rebuildStatics(const std::vector<WorldAabb>& bounds, const std::vector<uint32_t>* owner) {
+  bool changed = staticBuilds_ == 0 || staticStart_.back() != staticIds_.size();
+  for (const ChunkScan& scan : chunkScan_) changed = changed || scan.staticChanged;
   if (!changed) return false;
-  staticIds_.swap(staticScratch_);
+  staticIds_.clear();
+  // note: chunkStatics_ keeps lists of earlier, larger frames past this frame's chunks.
+  for (uint32_t c = 0; c < uint32_t(chunkScan_.size()); ++c)
+    staticIds_.insert(staticIds_.end(), chunkStatics_[c].begin(), chunkStatics_[c].end());
   staticBoxes_.clear();
   staticOwner_.clear();
   slots_.clear();
@@ -309,24 +369,22 @@ void IncrementalBroadphase::keepPairs(bool staticChanged, bool bulk) {
   });
   join(chunkA_, chunks, keptMm_, stage_ + kJoinKept, "broadphase: join kept pairs");
   join(chunkS_, chunks, keptMs_, stage_ + kJoinKept, "broadphase: join kept pairs");
-  const MaybeZone z(profiler_, "broadphase: merge pairs", stage_ + kMerge);
-  mergedMm_.resize(keptMm_.size() + newMm_.size());
-  std::merge(keptMm_.begin(), keptMm_.end(), newMm_.begin(), newMm_.end(), mergedMm_.begin());
+  parallelMerge(keptMm_, newMm_, mergedMm_, jobs_, profiler_, "broadphase: merge pairs", stage_ + kMerge);
   mm_.swap(mergedMm_);
-  mergedMs_.resize(keptMs_.size() + newMs_.size());
-  std::merge(keptMs_.begin(), keptMs_.end(), newMs_.begin(), newMs_.end(), mergedMs_.begin());
+  parallelMerge(keptMs_, newMs_, mergedMs_, jobs_, profiler_, "broadphase: merge pairs", stage_ + kMerge + 1);
   ms_.swap(mergedMs_);
 }
 
 // The fat pairs whose proxies' bounds overlap now, as pairs of owners: the two lists filtered in
-// parallel (each stays sorted), then merged dropping repeats (an owner with several static
-// proxies, a grid's cover boxes, pairs with a body through each of them).
+// parallel (each stays sorted, an owner pair met through several static proxies, a grid's
+// cover boxes, kept once), then merged.
 void IncrementalBroadphase::tightPairs(const std::vector<WorldAabb>& bounds, std::vector<BodyPair>& pairs) {
   const uint32_t nmm = uint32_t(mm_.size()), total = nmm + uint32_t(ms_.size());
   const uint32_t grain = tuning::grainFor(total, tuning::kMinPairGrain);
   const uint32_t chunks = JobSystem::chunkCount(0, total, grain);
   if (chunkA_.size() < chunks) chunkA_.resize(chunks);
   if (chunkB_.size() < chunks) chunkB_.resize(chunks);
+  const auto touching = [&](const StaticPair& p) { return bounds[proxy_[p.key]].overlaps(staticBoxes_[p.slot]); };
   forChunks(total, grain, stage_ + kTight, "broadphase: bounds of kept pairs", [&](uint32_t begin, uint32_t end) {
     std::vector<BodyPair>& mm = chunkA_[begin / grain];
     std::vector<BodyPair>& ms = chunkB_[begin / grain];
@@ -337,18 +395,35 @@ void IncrementalBroadphase::tightPairs(const std::vector<WorldAabb>& bounds, std
       if (i + kPrefetch < std::min(end, nmm)) __builtin_prefetch(&bounds[proxy_[mm_[i + kPrefetch].b]]);
       if (bounds[proxy_[p.a]].overlaps(bounds[proxy_[p.b]])) mm.push_back(p);
     }
-    for (uint32_t i = std::max(begin, nmm); i < end; ++i) {
-      const StaticPair& p = ms_[i - nmm];
+    if (end <= nmm) return;
+    const uint32_t first = std::max(begin, nmm) - nmm, last = end - nmm;
+    // The owner pair last kept: one the chunk before kept, if this chunk starts inside its run.
+    BodyPair kept{kNone, kNone};
+    for (uint32_t j = first; j > 0 && ms_[j - 1].owners == ms_[first].owners; --j)
+      if (touching(ms_[j - 1])) {
+        kept = ms_[first].owners;
+        break;
+      }
+    for (uint32_t i = first; i < last; ++i) {
+      const StaticPair& p = ms_[i];
       // note: the static pairs run by owner pair, so their moving proxies' bounds are read out
       // of order (a grid's pairs span every key): fetched kPrefetch pairs ahead (1M bodies: 117
       // -> 58 ms a frame).
-      if (i + kPrefetch < end) __builtin_prefetch(&bounds[proxy_[ms_[i + kPrefetch - nmm].key]]);
-      if ((ms.empty() || !(ms.back() == p.owners)) && bounds[proxy_[p.key]].overlaps(staticBoxes_[p.slot])) ms.push_back(p.owners);
+      if (i + kPrefetch < last) __builtin_prefetch(&bounds[proxy_[ms_[i + kPrefetch].key]]);
+      if (!(kept == p.owners) && touching(p)) {
+        ms.push_back(p.owners);
+        kept = p.owners;
+      }
     }
   });
   tests_ += total;
   join(chunkA_, chunks, outMm_, stage_ + kJoinTight, "broadphase: join pairs");
   join(chunkB_, chunks, outMs_, stage_ + kJoinTight, "broadphase: join pairs");
+  if (!mixedOwners_) {
+    // An owner is static or moving, never both: no pair can come from both lists.
+    parallelMerge(outMm_, outMs_, pairs, jobs_, profiler_, "broadphase: merge pairs", stage_ + kMergeOut);
+    return;
+  }
   const MaybeZone z(profiler_, "broadphase: merge pairs", stage_ + kMergeOut);
   pairs.clear();
   size_t i = 0, j = 0;
@@ -366,15 +441,21 @@ void IncrementalBroadphase::update(const std::vector<WorldAabb>& bounds, const s
   stage_ = stage;
   tests_ = 0;
   bool staticChanged;
+  gather(bounds, isStatic, owner);
   {
-    const MaybeZone z(profiler, "broadphase: gather", stage + kGather);
-    validateProxies(bounds, isStatic, owner, "IncrementalBroadphase::update");
-    gather(bounds, isStatic, owner);
-    // Nothing was changed that lasts before here: the checks are done.
-    staticChanged = staticSetChanged(bounds, isStatic, owner);
+    const MaybeZone z(profiler, "broadphase: statics", stage + kStatics);
+    staticChanged = rebuildStatics(bounds, owner);
+    // Proxies gone since the last frame (none when the keys are the same), and whether an owner
+    // has both static and moving proxies (it can pair with a body through both).
+    const bool keysChanged = lastKeys_ != keys_;
     removed_.clear();
-    for (const uint32_t key : lastKeys_)
-      if (seen_[key] != frame_) removed_.push_back(key);
+    if (keysChanged)
+      for (const uint32_t key : lastKeys_)
+        if (seen_[key] != frame_) removed_.push_back(key);
+    if (keysChanged || staticChanged) {
+      mixedOwners_ = false;
+      for (const uint32_t o : staticOwner_) mixedOwners_ = mixedOwners_ || (o < seen_.size() && seen_[o] == frame_);
+    }
   }
   fatten(bounds);
   const bool bulk = editTree(staticChanged);

@@ -39,7 +39,7 @@ namespace bw {
 class IncrementalBroadphase {
  public:
   /// Profiler stages update() uses, from its `stage` argument on.
-  static constexpr int kStages = 20 + DynamicBoundsTree::kBuildStages + DynamicBoundsTree::kSelfPairStages;
+  static constexpr int kStages = 23 + DynamicBoundsTree::kBuildStages + DynamicBoundsTree::kSelfPairStages;
 
   IncrementalBroadphase();
   ~IncrementalBroadphase();
@@ -83,7 +83,7 @@ class IncrementalBroadphase {
   template <class F>
   void forChunks(uint32_t n, uint32_t grain, int stage, const char* zone, F&& body);
   void gather(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner);
-  bool staticSetChanged(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, const std::vector<uint32_t>* owner);
+  bool rebuildStatics(const std::vector<WorldAabb>& bounds, const std::vector<uint32_t>* owner);
   void fatten(const std::vector<WorldAabb>& bounds);
   bool editTree(bool staticChanged);
   bool moveLeaves();
@@ -109,6 +109,17 @@ class IncrementalBroadphase {
   std::vector<uint8_t> moved_;
   uint32_t frame_ = 0;
   std::vector<uint32_t> keys_, lastKeys_, removed_, movedKeys_;
+  // gather()'s chunks: (key, proxy) of each moving proxy, and what the scan found.
+  struct ChunkScan {
+    uint32_t largest = 0;
+    bool ascending = true, bad = false, staticChanged = false;
+  };
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> chunkKeys_;
+  std::vector<std::vector<uint32_t>> chunkStatics_;  // the static proxies of each chunk
+  std::vector<uint32_t> staticStart_;                // each chunk's first static slot
+  std::vector<std::pair<uint32_t, uint32_t>> sortedKeys_;
+  std::vector<ChunkScan> chunkScan_;
+  bool mixedOwners_ = false;
   std::vector<uint32_t> spatial_, movedOrder_;  // keys in leaf order: all of them, the moved ones
   std::vector<uint64_t> byLeaf_;
   std::vector<std::vector<uint32_t>> chunkMoved_;
@@ -117,7 +128,7 @@ class IncrementalBroadphase {
   std::vector<uint32_t> buildLeaves_;
 
   // Static proxies: their ids, boxes and owners, by slot (the static tree's payload).
-  std::vector<uint32_t> staticIds_, staticScratch_, staticOwner_, slots_;
+  std::vector<uint32_t> staticIds_, staticOwner_, slots_;
   std::vector<WorldAabb> staticBoxes_;
   std::unique_ptr<StaticBoundsTree> staticTree_;
 

@@ -286,15 +286,16 @@ class World {
   void breakTerrainFree(std::vector<WorldAabb>& changed);
   /// A dynamic grid body's mass, centre of mass and inertia after its grid was edited.
   void refreshGridBodyMass(uint32_t body);
-  // Profiling stages per substep: broadphase proxies (0), contacts (1), waking touched sleepers (2),
-  // solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first), sleeping's two
-  // passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11: union,
-  // 12: flatten; 13 unused), the broadphase (kBroadphaseStage, its kStages), terrain pairs
+  // Profiling stages per substep: broadphase proxies counted (0), contacts (1), waking touched
+  // sleepers (2), solve (3), integrate (4), relax (5), gravity + bounds (6, which runs first),
+  // sleeping's two passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11:
+  // union, 12: flatten), broadphase proxies' offsets (13) and written (14), the broadphase
+  // (kBroadphaseStage, its kStages), terrain pairs
   // (kTerrainStage: select, plan, cut, pieces, finish, apply), the pair cache and the other steps between
   // (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded, stored after
   // the solve and after the relax, counters; then + 8 .. + 13 contacts grouped by island).
   // Every piece of a substep's work is in one of them: work/span sees the whole step.
-  static constexpr int kBroadphaseStage = 14;
+  static constexpr int kBroadphaseStage = 15;
   static constexpr int kTerrainStage = kBroadphaseStage + IncrementalBroadphase::kStages;
   static constexpr int kContactStepsStage = kTerrainStage + 6;
   static constexpr int kStagesPerSubstep = kContactStepsStage + 14;
@@ -334,6 +335,14 @@ class World {
     std::vector<WorldAabb> boxes;    // world frame, with the broadphase margin
   };
   std::vector<GridCover> covers_;    // one per large static grid body
+  /// A large static grid's cover boxes, current (taken again after an edit).
+  const std::vector<WorldAabb>& coverOf(uint32_t body);
+  // findPairs()'s chunks of bodies: proxies of single boxes, covered grids, the first proxy.
+  struct ProxyChunk {
+    uint32_t singles = 0, offset = 0;
+    std::vector<uint32_t> covered;
+  };
+  std::vector<ProxyChunk> proxyChunks_;
   std::vector<WorldAabb> proxyBounds_;
   std::vector<uint8_t> proxyStatic_;
   std::vector<uint32_t> proxyBody_;

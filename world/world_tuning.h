@@ -50,8 +50,8 @@ inline constexpr double kFatRebuildShare = 0.1;
 /// Fewest proxies per job of the broadphase's per-proxy stages (a containment test, or a tree
 /// query of a moved proxy) and fewest pairs per job of its pair filters.
 inline constexpr uint32_t kMinProxyGrain = 256;
-inline constexpr uint32_t kMinQueryGrain = 32;
-inline constexpr uint32_t kMinPairGrain = 1024;
+inline constexpr uint32_t kMinQueryGrain = 8;
+inline constexpr uint32_t kMinPairGrain = 256;
 /// Static grids of at least this many bricks enter the broadphase as at most kCoverBoxes boxes
 /// covering their bricks (BrickGrid::coverBoxes). 512 measured against 256 and 1024 on
 /// crates_on_grid, city_rain and lighthouse: 1024 slows the sweep more than it saves in pairs,

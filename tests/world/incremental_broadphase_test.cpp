@@ -297,6 +297,42 @@ TEST(IncrementalBroadphase, ManyMovesRebuildTheTreeInBulkAndFewMoveLeaves) {
   }
 }
 
+TEST(IncrementalBroadphase, OwnersWithStaticAndMovingProxiesPairOnce) {
+  // An owner may hold static proxies beside its one moving proxy (a body with fixed parts): a
+  // body touching both pairs with it once. Owners listed out of order are taken too.
+  SeededRandom r(55);
+  std::vector<WorldAabb> b;
+  std::vector<uint8_t> st;
+  std::vector<uint32_t> owner;
+  for (uint32_t body = 0; body < 400; ++body) {
+    const uint32_t o = (body * 37) % 400;  // owners out of order
+    const Vec3d c(r.uniform(-30, 30), r.uniform(-30, 30), r.uniform(0, 10));
+    const Vec3d h = Vec3d::Constant(r.logUniform(0.2, 3));
+    b.push_back({c - h, c + h});
+    st.push_back(0);
+    owner.push_back(o);
+    if (body % 10 == 0)
+      for (int k = 1; k <= 3; ++k) {  // three fixed parts next to it
+        b.push_back({c - h + Vec3d(k * 1.5, 0, 0), c + h + Vec3d(k * 1.5, 0, 0)});
+        st.push_back(1);
+        owner.push_back(o);
+      }
+  }
+  IncrementalBroadphase bp;
+  std::vector<BodyPair> pairs;
+  for (int frame = 0; frame < 5; ++frame) {
+    bp.update(b, st, pairs, nullptr, nullptr, -1, &owner);
+    ASSERT_EQ(pairs, brutePairs(b, st, &owner)) << "frame " << frame;
+    for (uint32_t i = 0; i < b.size(); ++i)
+      if (!st[i]) {
+        const Vec3d d(r.normal() * 0.4, r.normal() * 0.4, 0);
+        b[i].min += d;
+        b[i].max += d;
+      }
+  }
+  EXPECT_GT(pairs.size(), 100u);
+}
+
 TEST(IncrementalBroadphase, BadInputIsRefusedAndChangesNothing) {
   SeededRandom r(54);
   ProxyWorld w = makeWorld(r, 300, Vec3d::Zero());
@@ -338,6 +374,15 @@ TEST(IncrementalBroadphase, BadInputIsRefusedAndChangesNothing) {
   changeWorld(w, r, 0);
   bp.update(w.bounds, w.isStatic, pairs, nullptr, nullptr, -1, &w.owner);
   EXPECT_EQ(pairs, brutePairs(w.bounds, w.isStatic, &w.owner));
+  // Every proxy gone, then back: nothing kept from before.
+  const std::vector<WorldAabb> none;
+  const std::vector<uint8_t> noFlags;
+  const std::vector<uint32_t> noOwners;
+  bp.update(none, noFlags, pairs, nullptr, nullptr, -1, &noOwners);
+  EXPECT_TRUE(pairs.empty());
+  bp.update(w.bounds, w.isStatic, pairs, nullptr, nullptr, -1, &w.owner);
+  EXPECT_EQ(pairs, brutePairs(w.bounds, w.isStatic, &w.owner));
+  bp.movingTree().validate();
 }
 
 }  // namespace
