@@ -221,9 +221,14 @@ void IncrementalBroadphase::fatten(const std::vector<WorldAabb>& bounds) {
       const WorldAabb& b = bounds[proxy_[key]];
       const Vec3d c = (b.min + b.max) * 0.5;
       const bool fresh = leaf_[key] == kNone;
-      if (fresh || !contains(fat_[key], b)) {
-        // note: a new proxy's last centre is stale (or unset): no prediction for it.
-        const Vec3d ahead = fresh ? Vec3d::Zero() : Vec3d(((c - centre_[key]) * tuning::kFatPrediction).cwiseMin(limit).cwiseMax(-limit));
+      // note: a new proxy's last centre is stale (or unset): no prediction for it.
+      const Vec3d ahead = fresh ? Vec3d::Zero() : Vec3d(((c - centre_[key]) * tuning::kFatPrediction).cwiseMin(limit).cwiseMax(-limit));
+      // A box stretched for a fall that has ended (a crate landed on a pile) would keep pairs
+      // with everything under it: when its slack is over kFatLoose times what the motion now
+      // needs, it is made again.
+      const Vec3d slack = (fat_[key].max - fat_[key].min) - (b.max - b.min);
+      const Vec3d needed = ahead.cwiseAbs() + 2 * margin;
+      if (fresh || !contains(fat_[key], b) || (slack.array() > tuning::kFatLoose * needed.array()).any()) {
         fat_[key] = {b.min - margin + ahead.cwiseMin(0.0), b.max + margin + ahead.cwiseMax(0.0)};
         moved_[key] = 1;
         out.push_back(key);

@@ -13,8 +13,11 @@
 // with 4 grids per 500 x 500 m (at least 4): z stays 0-60 m, so the area follows n and the
 // density stays constant. Every method runs the same frames (600, 120, 24, 12 at 1k-1M); its
 // time is the pair finding alone (manual time: moving the bodies is left out):
-//   SweepAndPrune     - the world's choice, given a JobSystem(1): its parallel path (chunks,
-//                       job-system sorts) on one thread
+//   IncrementalBroadphase - the world's choice, given a JobSystem(1): its parallel path (chunks,
+//                       job-system sorts and merges, the tree's bulk builds) on one thread;
+//                       pairs kept over fat boxes, found anew for bodies that left theirs
+//   SweepAndPrune     - the world's broadphase until session 17 (every pair found every frame),
+//                       on JobSystem(1)
 //   btDbvtBroadphase  - Bullet's default broadphase as an expert sets it up for many moving
 //                       bodies: proxies created once (statics in group StaticFilter, so no
 //                       static-static pairs), setAabb for every moved proxy, then
@@ -37,13 +40,15 @@
 //                    last frames. A row whose pairs differ fails (SkipWithError, an error line,
 //                    and bench_world exits 1).
 //   tests          - interval and box comparisons per frame (nan: Bullet does not count them)
-//   cache_pairs    - pairs in Bullet's cache before the exact test (nan for our methods)
+//   cache_pairs    - pairs kept before the exact test: Bullet's cache, IncrementalBroadphase's
+//                    fat-box pairs (nan for the others)
+//   moved          - IncrementalBroadphase: bodies that left their fat boxes per frame
 //   first_frame_ms - the first frame from a fresh structure (every proxy created or loaded,
 //                    the pairs found), measured once before the timed frames; issue 17's goal:
 //                    100k <= 100 ms, 1M <= 1.5 s on one thread
-// Only SweepAndPrune sorts its pairs (its determinism contract); the others leave theirs in
-// their own order. The summary prints, per n, each method's frame and first-frame times and
-// their ratios to SweepAndPrune's.
+// Only our two sort their pairs (their determinism contract); the others leave theirs in their
+// own order. The summary prints, per n, each method's frame and first-frame times and their
+// ratios to IncrementalBroadphase's.
 //
 // BulletDbvtSettings/<setting>/<n> (10k and 100k; not matched by --benchmark_filter=Broadphase):
 // the btDbvtBroadphase settings tried, same workload and counters. static-filter is the base
