@@ -39,10 +39,12 @@ inline constexpr double kBroadphaseMargin = 0.02;
 /// kFatPredictionLimit m per axis, so a body that jumps does not get a huge box). While its
 /// bounds stay inside, its pairs are kept without a query. Stretching by the displacement leaves
 /// resting bodies (a pile's jitter) with small boxes, so few pairs that never touch are kept.
-/// Chosen by bench_world Broadphase/* (profiles/RESULTS.md, session 17): bodies moving 0.02-0.08
-/// m a frame leave 10-12% of their boxes a frame at 2 updates ahead, 1-2% at 16.
+/// Chosen by bench_world Broadphase/* and the shipped scenes (profiles/RESULTS.md, session 17):
+/// bodies moving 0.02-0.08 m a frame leave 10-12% of their boxes a frame at 2 updates ahead,
+/// 5.4% at 16, 3.2% at 32 (1k bodies: 0.065 -> 0.051 ms a frame from 16 to 32; ship_refit's
+/// crates riding a ship at 4 m/s: 0.59 -> 0.45 ms).
 inline constexpr double kFatMargin = 0.1;
-inline constexpr double kFatPrediction = 16.0;
+inline constexpr double kFatPrediction = 32.0;
 inline constexpr double kFatPredictionLimit = 4.0;
 /// A fat box whose slack (its extent beyond the bounds, per axis) is over kFatLoose times what
 /// the body's motion now needs is made again: a crate stretched 2.7 m for its fall and then
