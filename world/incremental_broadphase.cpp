@@ -274,7 +274,8 @@ bool IncrementalBroadphase::moveLeaves() {
       moved_[key] = 1;  // its pairs go with it
     }
     const uint32_t m = uint32_t(keys_.size());
-    const bool bulk = movedKeys_.size() > 64 && double(movedKeys_.size()) > tuning::kFatRebuildShare * double(m);
+    const double moved = double(movedKeys_.size());
+    const bool bulk = moved > 64 && (moved > tuning::kFatRebuildShare * double(m) || moved > tuning::kFatRebuildMoves);
     if (!bulk) {
       for (const uint32_t key : movedKeys_) {
         if (leaf_[key] == kNone) {

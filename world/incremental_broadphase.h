@@ -6,7 +6,7 @@
 /// tuning::kFatMargin and stretched along its last displacement (tuning::kFatPrediction). While
 /// its bounds stay inside, the proxy costs one containment test a frame. One that leaves (or is
 /// new) gets a new fat box, moves in a DynamicBoundsTree (or the tree is built again in bulk
-/// when more than tuning::kFatRebuildShare of the proxies moved), and queries that tree and the
+/// when many of the proxies moved: tuning::kFatRebuildShare), and queries that tree and the
 /// static proxies' StaticBoundsTree, in parallel chunks. The kept pair lists, sorted, drop the
 /// pairs of proxies that moved and take the new ones in a merge. Every frame the kept pairs are
 /// filtered by the proxies' current bounds, so the output is exactly the overlapping pairs, the

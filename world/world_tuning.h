@@ -51,9 +51,17 @@ inline constexpr double kFatPredictionLimit = 4.0;
 /// resting on a pile kept pairs with every crate under it (crate_pile: 0.9 ms a frame testing
 /// them).
 inline constexpr double kFatLoose = 3.0;
-/// When more than this share of the moving proxies left their fat boxes in one frame, their
-/// tree is built again in bulk (in parallel) instead of moving each leaf (serial).
-inline constexpr double kFatRebuildShare = 0.1;
+/// When more than kFatRebuildShare of the moving proxies, or more than kFatRebuildMoves, left
+/// their fat boxes in one update, their tree is built again in bulk (in parallel, and its pairs
+/// found by the tree against itself) instead of moving each leaf (serial) and querying it. A
+/// leaf's move costs more as the tree outgrows the caches (~0.15 us at 1k leaves, ~1 us at
+/// 100k, ~4 us at 1M) where a bulk build costs 0.2-0.4 us a leaf. Measured (bench_world
+/// Broadphase/*, the shipped rains): a share of 0.1 built city_rain's and lighthouse's rains in
+/// bulk every few frames (lighthouse's broadphase p95 1.03-1.15 ms, 0.86-0.89 at 0.25 and 0.5);
+/// 0.5 made the 10k bench row's first frames query leaf by leaf (0.56 -> 0.77 ms a frame), 0.25
+/// gave 0.49.
+inline constexpr double kFatRebuildShare = 0.25;
+inline constexpr uint32_t kFatRebuildMoves = 25000;
 /// Fewest proxies per job of the broadphase's per-proxy stages (a containment test, or a tree
 /// query of a moved proxy) and fewest pairs per job of its pair filters.
 inline constexpr uint32_t kMinProxyGrain = 256;
