@@ -78,6 +78,24 @@ void DynamicBoundsTree::move(uint32_t leaf, const WorldAabb& box) {
   insertLeaf(leaf);
 }
 
+uint32_t DynamicBoundsTree::refit(uint32_t leaf, const WorldAabb& box, uint32_t maxGrown) {
+  if (leaf >= nodes_.size() || !isLeaf(leaf) || nodes_[leaf].height != 0)
+    throw InvalidInput("DynamicBoundsTree::refit: node " + std::to_string(leaf) + " is not a leaf");
+  const auto holds = [&](uint32_t n) {
+    const WorldAabb& b = nodes_[n].box;
+    return (b.min.array() <= box.min.array()).all() && (box.max.array() <= b.max.array()).all();
+  };
+  uint32_t grown = 0;
+  for (uint32_t n = nodes_[leaf].parent; n != kNull && !holds(n); n = nodes_[n].parent)
+    if (++grown > maxGrown) {
+      move(leaf, box);
+      return 0;
+    }
+  nodes_[leaf].box = box;
+  for (uint32_t n = nodes_[leaf].parent, k = 0; k < grown; n = nodes_[n].parent, ++k) nodes_[n].box = merged(nodes_[n].box, box);
+  return grown;
+}
+
 void DynamicBoundsTree::replaceChild(uint32_t parent, uint32_t from, uint32_t to) {
   if (parent == kNull) {
     root_ = to;
@@ -377,7 +395,7 @@ void DynamicBoundsTree::selfTask(uint32_t n, std::vector<Task>& stack, Emit& emi
   crossPairs(nodes_[n].child1, nodes_[n].child2, stack, emit);
 }
 
-void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, JobSystem* jobs, Profiler* profiler, int stage) {
+void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wanted, JobSystem* jobs, Profiler* profiler, int stage) {
   out.clear();
   if (root_ == kNull) return;
   // The top of the traversal, breadth first, until there are enough tasks to share: a subtree
@@ -421,7 +439,9 @@ void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, JobSystem* jobs, P
   const auto run = [&](uint32_t k) {
     std::vector<BodyPair>& pairs = taskPairs_[k];
     pairs.clear();
-    auto emit = [&](uint32_t p, uint32_t q) { pairs.push_back(p < q ? BodyPair{p, q} : BodyPair{q, p}); };
+    auto emit = [&](uint32_t p, uint32_t q) {
+      if (!wanted || wanted[p] || wanted[q]) pairs.push_back(p < q ? BodyPair{p, q} : BodyPair{q, p});
+    };
     const Task& t = tasks_[k];
     if (t.b == kNull) {
       selfTask(t.a, taskStacks_[k], emit);
@@ -484,8 +504,10 @@ void DynamicBoundsTree::validate() const {
       const Node& a = nodes_[node.child1];
       const Node& b = nodes_[node.child2];
       if (node.height != 1 + std::max(a.height, b.height)) fail(n, "wrong height");
+      // note: refit() lets boxes hold more than their children (never less).
       const WorldAabb m = merged(a.box, b.box);
-      if (m.min != node.box.min || m.max != node.box.max) fail(n, "box is not its children's union");
+      if ((m.min.array() < node.box.min.array()).any() || (m.max.array() > node.box.max.array()).any())
+        fail(n, "box does not hold its children's");
     }
   }
   if (leaves != leaves_) throw std::logic_error("DynamicBoundsTree: " + std::to_string(leaves) + " leaves reached, " + std::to_string(leaves_) + " counted");

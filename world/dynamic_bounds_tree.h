@@ -48,6 +48,11 @@ class DynamicBoundsTree {
   void remove(uint32_t leaf);
   /// Gives the leaf a new box (taken out and inserted again; the index stays).
   void move(uint32_t leaf, const WorldAabb& box);
+  /// Gives the leaf a new box in place when at most `maxGrown` ancestors must grow to hold it
+  /// (they grow, up to the first that already holds it, and never shrink: the tree stays
+  /// correct but loosens a little); otherwise moves it as move() does. Returns the ancestors
+  /// grown (0 after a move).
+  uint32_t refit(uint32_t leaf, const WorldAabb& box, uint32_t maxGrown);
   /// Replaces the whole tree by one built in bulk over boxes[k] with payload ids[k];
   /// leafOf[k] becomes the leaf of item k. With jobs, levels split in parallel (zones at stage ..
   /// stage + kBuildStages - 1 with a profiler).
@@ -61,17 +66,19 @@ class DynamicBoundsTree {
   uint32_t id(uint32_t leaf) const { return nodes_[leaf].child2; }
   /// Every pair of leaves whose boxes overlap, as (smaller id, larger id), sorted: the tree
   /// against itself (each subtree against itself, then its two children against each other),
-  /// which after a bulk build costs far less than one query per leaf. The top of the
-  /// traversal is cut into tasks run as parallel jobs with their own lists, joined in task order.
-  void selfPairs(std::vector<BodyPair>& out, JobSystem* jobs = nullptr, Profiler* profiler = nullptr, int stage = -1);
+  /// which after a bulk build costs far less than one query per leaf. With `wanted` (indexed by
+  /// id), only pairs with at least one wanted leaf. The top of the traversal is cut into tasks
+  /// run as parallel jobs with their own lists, joined in task order.
+  void selfPairs(std::vector<BodyPair>& out, const uint8_t* wanted = nullptr, JobSystem* jobs = nullptr, Profiler* profiler = nullptr,
+                 int stage = -1);
   /// Profiler stages selfPairs() uses (the traversal, the join, the sort's four).
   static constexpr int kSelfPairStages = 6;
   /// The ids of all leaves in node order: a bulk-built tree's leaves lie in the order of its
   /// splits (near in space, near in the list), and move() keeps a leaf's index, so queries made
   /// in this order walk the tree coherently.
   void leafIds(std::vector<uint32_t>& out) const;
-  /// Checks every link, height, box and the free list (tests); throws std::logic_error naming
-  /// the node that is wrong.
+  /// Checks every link, height, box (holding its children's) and the free list (tests); throws
+  /// std::logic_error naming the node that is wrong.
   void validate() const;
 
   /// Calls f(id) for every leaf whose box overlaps `box` (closed intervals). Returns the box

@@ -3,14 +3,17 @@
 /// anew only for the proxies that moved (box2d v3's move buffer, with a deterministic merge).
 ///
 /// Each moving proxy (dynamic, kinematic or asleep) owns a fat box: its bounds grown by
-/// tuning::kFatMargin and stretched along its last displacement (tuning::kFatPrediction). While
-/// its bounds stay inside, the proxy costs one containment test a frame. One that leaves (or is
-/// new) gets a new fat box, moves in a DynamicBoundsTree (or the tree is built again in bulk
-/// when many of the proxies moved: tuning::kFatRebuildShare), and queries that tree and the
-/// static proxies' StaticBoundsTree, in parallel chunks. The kept pair lists, sorted, drop the
-/// pairs of proxies that moved and take the new ones in a merge. Every frame the kept pairs are
-/// filtered by the proxies' current bounds, so the output is exactly the overlapping pairs, the
-/// same as SweepAndPrune's (which the bench and tests compare it with).
+/// tuning::kFatMargin and stretched ahead along its last displacement (tuning::kFatPrediction).
+/// While its bounds stay inside, the proxy costs one containment test a frame. One that leaves
+/// (or is new, or whose box is far looser than its motion now needs) gets a new fat box; its
+/// leaf in a DynamicBoundsTree keeps its place when a couple of ancestors grown can hold the new
+/// box, else is moved; when many proxies moved (tuning::kFatRebuildShare), or the ancestors grown
+/// since the last build outnumber the leaves, the tree is built again in bulk and its pairs with
+/// a moved proxy found by the tree against itself. Moved proxies query the tree and the static
+/// proxies' StaticBoundsTree in parallel chunks. The kept pair lists, sorted, drop the pairs of
+/// proxies that moved and take the new ones in a merge. Every frame the kept pairs are filtered
+/// by the proxies' current bounds, so the output is exactly the overlapping pairs, the same as
+/// SweepAndPrune's (which the bench and tests compare it with).
 ///
 /// Why, measured in bench_world Broadphase/* at 1k-1M bodies against Bullet's tuned
 /// btDbvtBroadphase and the previous SweepAndPrune (profiles/RESULTS.md, session 17): a sweep
@@ -88,7 +91,7 @@ class IncrementalBroadphase {
   bool editTree(bool staticChanged);
   bool moveLeaves();
   void findNewPairs(bool staticChanged, bool bulk);
-  void keepPairs(bool staticChanged, bool bulk);
+  void keepPairs(bool staticChanged);
   void tightPairs(const std::vector<WorldAabb>& bounds, std::vector<BodyPair>& pairs);
   // Concatenates per-chunk lists in chunk order into `out`, in parallel.
   template <class T>
@@ -99,7 +102,7 @@ class IncrementalBroadphase {
   int stage_ = -1;
   uint64_t tests_ = 0;
   uint32_t movedCount_ = 0;
-  uint64_t staticBuilds_ = 0, movingBuilds_ = 0;
+  uint64_t staticBuilds_ = 0, movingBuilds_ = 0, grownSinceBuild_ = 0;
 
   // Per key (a moving proxy's owner): the proxy this frame, the frame it was last seen, its
   // leaf in tree_, its fat box, its bounds' centre last frame, whether it moved this frame.

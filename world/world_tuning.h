@@ -55,13 +55,18 @@ inline constexpr double kFatLoose = 3.0;
 /// their fat boxes in one update, their tree is built again in bulk (in parallel, and its pairs
 /// found by the tree against itself) instead of moving each leaf (serial) and querying it. A
 /// leaf's move costs more as the tree outgrows the caches (~0.15 us at 1k leaves, ~1 us at
-/// 100k, ~4 us at 1M) where a bulk build costs 0.2-0.4 us a leaf. Measured (bench_world
-/// Broadphase/*, the shipped rains): a share of 0.1 built city_rain's and lighthouse's rains in
-/// bulk every few frames (lighthouse's broadphase p95 1.03-1.15 ms, 0.86-0.89 at 0.25 and 0.5);
-/// 0.5 made the 10k bench row's first frames query leaf by leaf (0.56 -> 0.77 ms a frame), 0.25
-/// gave 0.49.
-inline constexpr double kFatRebuildShare = 0.25;
+/// 100k, ~4 us at 1M) where a bulk build costs 0.2-0.4 us a leaf, and the moves are serial:
+/// measured (bench_world Broadphase/*, the shipped rains), a share of 0.25 took a few tenths of
+/// a millisecond off one-thread rain frames (lighthouse's broadphase p95 1.03-1.15 -> 0.81-0.89
+/// ms, the 10k bench row 0.56 -> 0.49 ms) but put crates_on_grid's leaf moves on the critical
+/// path (4.5-5.4 ms of its 16-thread bound, 1.7-2.0 at 0.1: bound 7.6-7.7x against 8.8-9.0x).
+inline constexpr double kFatRebuildShare = 0.1;
 inline constexpr uint32_t kFatRebuildMoves = 25000;
+/// A proxy that left its fat box keeps its leaf when at most this many of its ancestors must
+/// grow to hold the new box (they grow, and the tree loosens a little); otherwise its leaf is
+/// taken out and inserted again. The tree is built again in bulk once the ancestors grown since
+/// its last build outnumber its leaves.
+inline constexpr uint32_t kFatRefitLevels = 2;
 /// Fewest proxies per job of the broadphase's per-proxy stages (a containment test, or a tree
 /// query of a moved proxy) and fewest pairs per job of its pair filters.
 inline constexpr uint32_t kMinProxyGrain = 256;

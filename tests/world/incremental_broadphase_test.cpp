@@ -96,6 +96,60 @@ TEST(DynamicBoundsTree, EditsKeepItValidAndQueriesMatchBruteForce) {
   }
 }
 
+TEST(DynamicBoundsTree, RefitsLoosenWithoutLosingAnythingAndSelfPairsMatchBruteForce) {
+  for (const double offset : {0.0, 1e7}) {
+    SeededRandom r(offset == 0 ? 44 : 45);
+    const Vec3d origin = Vec3d::Constant(offset);
+    const uint32_t n = 1200;
+    std::vector<WorldAabb> boxes(n);
+    std::vector<uint32_t> ids(n), leaves;
+    for (uint32_t i = 0; i < n; ++i) {
+      boxes[i] = randomBox(r, origin, i % 4 == 0 ? 3 : 150);  // a dense cluster among sparse boxes
+      ids[i] = i;
+    }
+    DynamicBoundsTree tree;
+    tree.build(boxes, ids, leaves);
+    uint32_t refitted = 0, moved = 0;
+    for (int round = 0; round < 5; ++round) {
+      for (uint32_t i = 0; i < n; i += 3) {
+        // Small steps stay in place (ancestors grow), long ones are taken out and put back.
+        const double step = i % 2 == 0 ? 0.05 : 40;
+        const Vec3d d = Vec3d(r.normal(), r.normal(), r.normal()) * step;
+        boxes[i].min += d;
+        boxes[i].max += d;
+        const uint32_t before = tree.leafCount();
+        const uint32_t grown = tree.refit(leaves[i], boxes[i], 2);
+        ASSERT_LE(grown, 2u);
+        ASSERT_EQ(tree.leafCount(), before);
+        ASSERT_EQ(tree.id(leaves[i]), i);  // the leaf index stays either way
+        (step < 1 ? refitted : moved) += 1;
+      }
+      tree.validate();  // every box holds its children's
+      std::vector<uint8_t> wanted(n, 0);
+      for (uint32_t i = 0; i < n; i += 7) wanted[i] = 1;
+      for (const bool filtered : {false, true}) {
+        std::vector<BodyPair> got, expected;
+        JobSystem jobs(2);
+        tree.selfPairs(got, filtered ? wanted.data() : nullptr, round % 2 ? &jobs : nullptr);
+        for (uint32_t i = 0; i < n; ++i)
+          for (uint32_t j = i + 1; j < n; ++j)
+            if (boxes[i].overlaps(boxes[j]) && (!filtered || wanted[i] || wanted[j])) expected.push_back({i, j});
+        ASSERT_EQ(got, expected) << "round " << round << (filtered ? ", filtered" : "") << ", offset " << offset;
+        if (!filtered) EXPECT_GT(got.size(), 1000u);
+      }
+      for (int q = 0; q < 40; ++q) {
+        const WorldAabb box = randomBox(r, origin, 150);
+        std::vector<uint32_t> found;
+        tree.query(box, [&](uint32_t id) { found.push_back(id); });
+        std::sort(found.begin(), found.end());
+        ASSERT_EQ(found, bruteQuery(boxes, ids, box));
+      }
+    }
+    EXPECT_GT(refitted, 0u);
+    EXPECT_GT(moved, 0u);
+  }
+}
+
 TEST(DynamicBoundsTree, BulkBuildsOfAnySizeAndBadCallsAreRefused) {
   SeededRandom r(43);
   for (const uint32_t n : {0u, 1u, 2u, 3u, 7u, 2049u, 5000u}) {
@@ -131,6 +185,7 @@ TEST(DynamicBoundsTree, BulkBuildsOfAnySizeAndBadCallsAreRefused) {
   const uint32_t b = tree.insert({Vec3d::Ones(), Vec3d::Constant(2)}, 2);
   EXPECT_THROW(tree.remove(tree.leafCount() + 5), InvalidInput);  // past the nodes
   EXPECT_THROW(tree.move(9999, {Vec3d::Zero(), Vec3d::Ones()}), InvalidInput);
+  EXPECT_THROW(tree.refit(9999, {Vec3d::Zero(), Vec3d::Ones()}, 2), InvalidInput);
   tree.remove(a);
   EXPECT_THROW(tree.remove(a), InvalidInput);  // freed
   tree.validate();
