@@ -2,26 +2,14 @@
 
 #include <algorithm>
 #include <cstring>
-#include <optional>
 #include <string>
 
 #include "collision/core/argument_checks.h"
+#include "jobs/chunked_for.h"
 #include "world/static_bounds_tree.h"
 #include "world/world_tuning.h"
 
 namespace bw {
-
-namespace {
-
-// A profiling zone when there is a profiler.
-struct MaybeZone {
-  std::optional<ProfileZone> zone;
-  MaybeZone(Profiler* profiler, const char* name, int stage) {
-    if (profiler) zone.emplace(*profiler, name, stage);
-  }
-};
-
-}  // namespace
 
 SweepAndPrune::SweepAndPrune() : staticTree_(std::make_unique<StaticBoundsTree>()) {}
 SweepAndPrune::~SweepAndPrune() = default;
@@ -109,7 +97,7 @@ void SweepAndPrune::update(const std::vector<WorldAabb>& bounds, const std::vect
                            JobSystem* jobs, Profiler* profiler, int stage, const std::vector<uint32_t>* owner) {
   jobs_ = jobs;
   profiler_ = profiler;
-  MaybeZone orderZone(profiler, "broadphase: order", stage);
+  OptionalZone orderZone(profiler, "broadphase: order", stage);
   validateProxies(bounds, isStatic, owner, "SweepAndPrune::update");
   const uint32_t n = uint32_t(bounds.size());
   moving_.clear();
@@ -247,14 +235,7 @@ void SweepAndPrune::sortPairs(std::vector<BodyPair>& pairs, int stage) {
 
 template <class F>
 void SweepAndPrune::forChunks(uint32_t n, uint32_t grain, int stage, const char* zone, F&& body) {
-  if (jobs_) {
-    jobs_->parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
-      const MaybeZone z(profiler_, zone, stage);
-      body(begin, end);
-    });
-    return;
-  }
-  for (uint32_t begin = 0; begin < n; begin += grain) body(begin, std::min(n, begin + grain));
+  chunkedFor(jobs_, profiler_, n, grain, stage, zone, body);
 }
 
 }  // namespace bw

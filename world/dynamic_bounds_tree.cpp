@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "collision/core/errors.h"
+#include "jobs/chunked_for.h"
 
 namespace bw {
 
@@ -19,13 +19,6 @@ double halfArea(const WorldAabb& b) {
   const Vec3d d = b.max - b.min;
   return d.x() * d.y() + d.y() * d.z() + d.z() * d.x();
 }
-
-struct MaybeZone {
-  std::optional<ProfileZone> zone;
-  MaybeZone(Profiler* profiler, const char* name, int stage) {
-    if (profiler) zone.emplace(*profiler, name, stage);
-  }
-};
 
 }  // namespace
 
@@ -275,15 +268,7 @@ void DynamicBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::ve
   const uint32_t itemGrain = std::max<uint32_t>(1024, (n + 63) / 64);
   const uint32_t chunks = JobSystem::chunkCount(0, n, itemGrain);
   const auto forChunks = [&](uint32_t count, uint32_t grain, int at, const char* zone, const auto& body) {
-    if (!jobs) {
-      const MaybeZone z(profiler, zone, at);
-      for (uint32_t begin = 0; begin < count; begin += grain) body(begin, std::min(count, begin + grain));
-      return;
-    }
-    jobs->parallelFor(0, count, grain, [&](uint32_t begin, uint32_t end) {
-      const MaybeZone z(profiler, zone, at);
-      body(begin, end);
-    });
+    chunkedFor(jobs, profiler, count, grain, at, zone, body);
   };
   // 1. The centres' bounds (per chunk, joined in chunk order), then each item's Morton code on
   //    a 2^21 lattice over them; sorted by (code, item): near in space, near in the order.
@@ -332,7 +317,7 @@ void DynamicBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::ve
   whole_.clear();
   top_.clear();
   {
-    const MaybeZone z(profiler, "dynamic tree: top ranges", stage + 7);
+    const OptionalZone z(profiler, "dynamic tree: top ranges", stage + 7);
     while (!level_.empty()) {
       next_.clear();
       for (const Range& r : level_) {
@@ -354,7 +339,7 @@ void DynamicBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::ve
     for (uint32_t k = begin; k < end; ++k) buildSubtree(whole_[k]);
   });
   {
-    const MaybeZone z(profiler, "dynamic tree: top boxes", stage + 9);
+    const OptionalZone z(profiler, "dynamic tree: top boxes", stage + 9);
     for (auto it = top_.rbegin(); it != top_.rend(); ++it) fix(it->node);
   }
   leaves_ = n;
@@ -449,16 +434,11 @@ void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wan
       crossPairs(t.a, t.b, taskStacks_[k], emit);
     }
   };
-  if (jobs) {
-    jobs->parallelFor(0, count, 1, [&](uint32_t begin, uint32_t end) {
-      const MaybeZone z(profiler, "dynamic tree: pairs", stage);
-      for (uint32_t k = begin; k < end; ++k) run(k);
-    });
-  } else {
-    for (uint32_t k = 0; k < count; ++k) run(k);
-  }
+  chunkedFor(jobs, profiler, count, 1, stage, "dynamic tree: pairs", [&](uint32_t begin, uint32_t end) {
+    for (uint32_t k = begin; k < end; ++k) run(k);
+  });
   {
-    const MaybeZone z(profiler, "dynamic tree: join pairs", stage + 1);
+    const OptionalZone z(profiler, "dynamic tree: join pairs", stage + 1);
     taskOffset_.assign(count + 1, 0);
     for (uint32_t k = 0; k < count; ++k) taskOffset_[k + 1] = taskOffset_[k] + taskPairs_[k].size();
     out.resize(taskOffset_[count]);

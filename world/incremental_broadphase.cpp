@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cstring>
-#include <optional>
 #include <string>
 
 #include "collision/core/errors.h"
+#include "jobs/chunked_for.h"
 #include "jobs/parallel_merge.h"
 #include "world/static_bounds_tree.h"
 #include "world/world_tuning.h"
@@ -20,13 +20,6 @@ constexpr uint32_t kNone = DynamicBoundsTree::kNull;
 constexpr uint32_t kMaxOwner = 1u << 26;
 /// How far ahead the bounds filter prefetches a static pair's moving bounds.
 constexpr uint32_t kPrefetch = 16;
-
-struct MaybeZone {
-  std::optional<ProfileZone> zone;
-  MaybeZone(Profiler* profiler, const char* name, int stage) {
-    if (profiler) zone.emplace(*profiler, name, stage);
-  }
-};
 
 bool contains(const WorldAabb& outer, const WorldAabb& inner) {
   return (outer.min.array() <= inner.min.array()).all() && (inner.max.array() <= outer.max.array()).all();
@@ -63,14 +56,7 @@ IncrementalBroadphase& IncrementalBroadphase::operator=(IncrementalBroadphase&&)
 
 template <class F>
 void IncrementalBroadphase::forChunks(uint32_t n, uint32_t grain, int stage, const char* zone, F&& body) {
-  if (jobs_) {
-    jobs_->parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
-      const MaybeZone z(profiler_, zone, stage);
-      body(begin, end);
-    });
-    return;
-  }
-  for (uint32_t begin = 0; begin < n; begin += grain) body(begin, std::min(n, begin + grain));
+  chunkedFor(jobs_, profiler_, n, grain, stage, zone, body);
 }
 
 template <class T>
@@ -249,7 +235,7 @@ void IncrementalBroadphase::fatten(const std::vector<WorldAabb>& bounds) {
 // queries in key order, spread over the world, missed the cache at every level: 1.3 us each).
 bool IncrementalBroadphase::editTree(bool staticChanged) {
   const bool bulk = moveLeaves();
-  const MaybeZone z(profiler_, "broadphase: query order", stage_ + kOrder);
+  const OptionalZone z(profiler_, "broadphase: query order", stage_ + kOrder);
   if (bulk || staticChanged) tree_.leafIds(spatial_);
   if (bulk) {
     movedOrder_.clear();
@@ -267,7 +253,7 @@ bool IncrementalBroadphase::editTree(bool staticChanged) {
 
 bool IncrementalBroadphase::moveLeaves() {
   {
-    const MaybeZone z(profiler_, "broadphase: tree edits", stage_ + kTreeEdits);
+    const OptionalZone z(profiler_, "broadphase: tree edits", stage_ + kTreeEdits);
     for (const uint32_t key : removed_) {
       tree_.remove(leaf_[key]);
       leaf_[key] = kNone;
@@ -432,7 +418,7 @@ void IncrementalBroadphase::tightPairs(const std::vector<WorldAabb>& bounds, std
     parallelMerge(outMm_, outMs_, pairs, jobs_, profiler_, "broadphase: merge pairs", stage_ + kMergeOut);
     return;
   }
-  const MaybeZone z(profiler_, "broadphase: merge pairs", stage_ + kMergeOut);
+  const OptionalZone z(profiler_, "broadphase: merge pairs", stage_ + kMergeOut);
   pairs.clear();
   size_t i = 0, j = 0;
   while (i < outMm_.size() || j < outMs_.size()) {
@@ -451,7 +437,7 @@ void IncrementalBroadphase::update(const std::vector<WorldAabb>& bounds, const s
   bool staticChanged;
   gather(bounds, isStatic, owner);
   {
-    const MaybeZone z(profiler, "broadphase: statics", stage + kStatics);
+    const OptionalZone z(profiler, "broadphase: statics", stage + kStatics);
     staticChanged = rebuildStatics(bounds, owner);
     // Proxies gone since the last frame (none when the keys are the same), and whether an owner
     // has both static and moving proxies (it can pair with a body through both).
