@@ -11,7 +11,7 @@ cd "$(dirname "$0")/../.."
 seconds=${1:?usage: run_fuzzers.sh SECONDS [TARGET...]}
 shift
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(brs vox scene octobvh_edits grid_edits)
+[ ${#targets[@]} -gt 0 ] || targets=(brs vox scene octobvh_edits grid_edits broadphase)
 bin=build/fuzz/bin
 shared=../shared/data
 
@@ -38,6 +38,7 @@ run_one() {
       scene) opts+=(-runs=40000) ;;
       octobvh_edits) opts+=(-runs=12000) ;;
       grid_edits) opts+=(-runs=7000) ;;
+      broadphase) opts+=(-runs=10000) ;;
     esac
   fi
   # the real content files are large: only their first 64 KiB seed the byte targets
