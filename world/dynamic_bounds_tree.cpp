@@ -348,7 +348,8 @@ void DynamicBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::ve
 // ------------------------------------------------------------------------- the tree against itself
 
 template <class Emit>
-void DynamicBoundsTree::crossPairs(uint32_t a, uint32_t b, std::vector<Task>& stack, Emit& emit) const {
+uint64_t DynamicBoundsTree::crossPairs(uint32_t a, uint32_t b, std::vector<Task>& stack, Emit& emit) const {
+  uint64_t tests = 0;
   stack.clear();
   stack.push_back({a, b});
   while (!stack.empty()) {
@@ -356,6 +357,7 @@ void DynamicBoundsTree::crossPairs(uint32_t a, uint32_t b, std::vector<Task>& st
     stack.pop_back();
     const Node& x = nodes_[t.a];
     const Node& y = nodes_[t.b];
+    ++tests;
     if (!x.box.overlaps(y.box)) continue;
     if (x.child1 == kNull && y.child1 == kNull) {
       emit(x.child2, y.child2);
@@ -370,19 +372,19 @@ void DynamicBoundsTree::crossPairs(uint32_t a, uint32_t b, std::vector<Task>& st
       stack.push_back({x.child1, t.b});
     }
   }
+  return tests;
 }
 
 template <class Emit>
-void DynamicBoundsTree::selfTask(uint32_t n, std::vector<Task>& stack, Emit& emit) const {
-  if (isLeaf(n)) return;
-  selfTask(nodes_[n].child1, stack, emit);
-  selfTask(nodes_[n].child2, stack, emit);
-  crossPairs(nodes_[n].child1, nodes_[n].child2, stack, emit);
+uint64_t DynamicBoundsTree::selfTask(uint32_t n, std::vector<Task>& stack, Emit& emit) const {
+  if (isLeaf(n)) return 0;
+  return selfTask(nodes_[n].child1, stack, emit) + selfTask(nodes_[n].child2, stack, emit) +
+         crossPairs(nodes_[n].child1, nodes_[n].child2, stack, emit);
 }
 
-void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wanted, JobSystem* jobs, Profiler* profiler, int stage) {
+uint64_t DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wanted, JobSystem* jobs, Profiler* profiler, int stage) {
   out.clear();
-  if (root_ == kNull) return;
+  if (root_ == kNull) return 0;
   // The top of the traversal, breadth first, until there are enough tasks to share: a subtree
   // against itself becomes its children against themselves and each other; two subtrees
   // against each other become the larger one's children against the other (dropped when the
@@ -390,6 +392,7 @@ void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wan
   constexpr uint32_t kTasks = 256;
   constexpr int kRounds = 10;
   tasks_.assign(1, Task{root_, kNull});
+  uint64_t topTests = 0;
   for (int round = 0; round < kRounds && tasks_.size() < kTasks; ++round) {
     nextTasks_.clear();
     for (const Task& t : tasks_) {
@@ -403,6 +406,7 @@ void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wan
       }
       const Node& x = nodes_[t.a];
       const Node& y = nodes_[t.b];
+      ++topTests;
       if (!x.box.overlaps(y.box)) continue;
       if (x.child1 == kNull && y.child1 == kNull) {
         nextTasks_.push_back(t);
@@ -421,6 +425,7 @@ void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wan
     taskPairs_.resize(count);
     taskStacks_.resize(count);
   }
+  taskTests_.assign(count, 0);
   const auto run = [&](uint32_t k) {
     std::vector<BodyPair>& pairs = taskPairs_[k];
     pairs.clear();
@@ -428,11 +433,7 @@ void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wan
       if (!wanted || wanted[p] || wanted[q]) pairs.push_back(p < q ? BodyPair{p, q} : BodyPair{q, p});
     };
     const Task& t = tasks_[k];
-    if (t.b == kNull) {
-      selfTask(t.a, taskStacks_[k], emit);
-    } else {
-      crossPairs(t.a, t.b, taskStacks_[k], emit);
-    }
+    taskTests_[k] = t.b == kNull ? selfTask(t.a, taskStacks_[k], emit) : crossPairs(t.a, t.b, taskStacks_[k], emit);
   };
   chunkedFor(jobs, profiler, count, 1, stage, "dynamic tree: pairs", [&](uint32_t begin, uint32_t end) {
     for (uint32_t k = begin; k < end; ++k) run(k);
@@ -449,6 +450,9 @@ void DynamicBoundsTree::selfPairs(std::vector<BodyPair>& out, const uint8_t* wan
   } else {
     std::sort(out.begin(), out.end());
   }
+  uint64_t tests = topTests;
+  for (uint32_t k = 0; k < count; ++k) tests += taskTests_[k];
+  return tests;
 }
 
 void DynamicBoundsTree::leafIds(std::vector<uint32_t>& out) const {

@@ -68,9 +68,9 @@ class DynamicBoundsTree {
   /// against itself (each subtree against itself, then its two children against each other),
   /// which after a bulk build costs far less than one query per leaf. With `wanted` (indexed by
   /// id), only pairs with at least one wanted leaf. The top of the traversal is cut into tasks
-  /// run as parallel jobs with their own lists, joined in task order.
-  void selfPairs(std::vector<BodyPair>& out, const uint8_t* wanted = nullptr, JobSystem* jobs = nullptr, Profiler* profiler = nullptr,
-                 int stage = -1);
+  /// run as parallel jobs with their own lists, joined in task order. Returns the box tests made.
+  uint64_t selfPairs(std::vector<BodyPair>& out, const uint8_t* wanted = nullptr, JobSystem* jobs = nullptr, Profiler* profiler = nullptr,
+                     int stage = -1);
   /// Profiler stages selfPairs() uses (the traversal, the join, the sort's four).
   static constexpr int kSelfPairStages = 6;
   /// The ids of all leaves in node order: a bulk-built tree's leaves lie in the order of its
@@ -152,10 +152,11 @@ class DynamicBoundsTree {
   struct Task {
     uint32_t a, b;
   };
+  // Both return the box tests made.
   template <class Emit>
-  void crossPairs(uint32_t a, uint32_t b, std::vector<Task>& stack, Emit& emit) const;
+  uint64_t crossPairs(uint32_t a, uint32_t b, std::vector<Task>& stack, Emit& emit) const;
   template <class Emit>
-  void selfTask(uint32_t n, std::vector<Task>& stack, Emit& emit) const;
+  uint64_t selfTask(uint32_t n, std::vector<Task>& stack, Emit& emit) const;
 
   // Bulk build: the leaf node of build position p, a range's split into two, a whole subtree.
   uint32_t buildLeaf(uint32_t p) const { return buildCount_ - 1 + p; }
@@ -180,6 +181,7 @@ class DynamicBoundsTree {
   std::vector<std::vector<BodyPair>> taskPairs_;
   std::vector<std::vector<Task>> taskStacks_;
   std::vector<size_t> taskOffset_;
+  std::vector<uint64_t> taskTests_;
   ParallelSorter<BodyPair> pairSorter_;
 };
 

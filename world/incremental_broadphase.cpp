@@ -191,8 +191,9 @@ bool IncrementalBroadphase::rebuildStatics(const std::vector<WorldAabb>& bounds,
   return true;
 }
 
-// Each moving proxy's bounds against its fat box, in parallel: one that left it (or is new)
-// gets a new one and joins the moved list (joined in chunk order: ascending keys).
+// Each moving proxy's bounds against its fat box, in parallel: one that left it (or is new, or
+// whose box is far looser than it needs) gets a new one and joins the moved list (joined in
+// chunk order: ascending keys).
 void IncrementalBroadphase::fatten(const std::vector<WorldAabb>& bounds) {
   const uint32_t m = uint32_t(keys_.size());
   const uint32_t grain = tuning::grainFor(m, tuning::kMinProxyGrain);
@@ -229,8 +230,9 @@ void IncrementalBroadphase::fatten(const std::vector<WorldAabb>& bounds) {
   movedCount_ = uint32_t(movedKeys_.size());
 }
 
-// Leaves of proxies gone taken out; moved ones moved (serial, in key order), or the whole tree
-// built again in bulk when many moved. Then the order the queries run in: by leaf, so that
+// Leaves of proxies gone taken out; moved ones refit in place or moved (serial, in key order),
+// or the whole tree built again in bulk when many moved. Then the order the queries run in: by
+// leaf, so that
 // queries near in space run one after another and find the tree's nodes in cache (a million
 // queries in key order, spread over the world, missed the cache at every level: 1.3 us each).
 bool IncrementalBroadphase::editTree(bool staticChanged) {
@@ -293,7 +295,7 @@ bool IncrementalBroadphase::moveLeaves() {
 // build, the tree against itself gives every pair with a moved proxy at once (a million sparse
 // bodies: 4x faster than a query each).
 void IncrementalBroadphase::findNewPairs(bool staticChanged, bool bulk) {
-  if (bulk) tree_.selfPairs(newMm_, moved_.data(), jobs_, profiler_, stage_ + kSelf);
+  if (bulk) tests_ += tree_.selfPairs(newMm_, moved_.data(), jobs_, profiler_, stage_ + kSelf);
   const std::vector<uint32_t>& staticQueries = staticChanged ? spatial_ : movedOrder_;
   const uint32_t moved = bulk ? 0 : uint32_t(movedOrder_.size()), queries = uint32_t(staticQueries.size());
   const uint32_t items = std::max(moved, queries);
