@@ -53,16 +53,18 @@ class IncrementalBroadphase {
   /// never pair with each other). Replaces `pairs`. With `owner` (one entry per proxy), the
   /// pairs are of owners: (owner[i], owner[j]) for overlapping proxies i and j of different
   /// owners, each pair once. Throws InvalidInput, nothing changed, for non-finite or inverted
-  /// bounds (naming the proxy), mismatched lengths, or an owner with two moving proxies.
+  /// bounds (naming the proxy), mismatched lengths, an owner with two moving proxies, or an
+  /// owner id of 2^26 or more (per-owner state is kept in arrays indexed by it).
   /// With jobs, the stages run in chunks on it (the same pairs for any thread count); with a
   /// profiler, zones at stage .. stage + kStages - 1.
   void update(const std::vector<WorldAabb>& bounds, const std::vector<uint8_t>& isStatic, std::vector<BodyPair>& pairs,
               JobSystem* jobs = nullptr, Profiler* profiler = nullptr, int stage = -1,
               const std::vector<uint32_t>* owner = nullptr);
 
-  /// Box tests of the last update: tree queries and the kept pairs' bounds tests.
+  /// Box tests of the last update: tree queries (or a bulk frame's tree against itself) and the
+  /// kept pairs' bounds tests.
   uint64_t lastTests() const { return tests_; }
-  /// Moving proxies that got a new fat box in the last update (left it, or new).
+  /// Moving proxies that got a new fat box in the last update (left it, new, or far too loose).
   uint32_t lastMoved() const { return movedCount_; }
   /// Pairs of fat boxes kept after the last update (moving-moving and moving-static proxies).
   uint64_t fatPairs() const { return mm_.size() + ms_.size(); }
