@@ -102,55 +102,98 @@ struct StageTime {
   int32_t stage = 0;
   double work = 0, longest = 0, serial = 0;  // ms: all zones, the longest zone, the serial zones
 };
-// A frame has a few dozen stages at most and its zones come stage by stage: a flat list searched
-// from its end beats a map (the whole run's work/span is taken after every `run`).
-using StageTimes = std::vector<StageTime>;
 
-void addZone(StageTimes& stages, const ProfileEvent& e) {
-  const double ms = double(e.endNs - e.beginNs) * 1e-6;
-  auto it = std::find_if(stages.rbegin(), stages.rend(), [&](const StageTime& s) { return s.stage == e.stage; });
-  StageTime& s = it != stages.rend() ? *it : stages.emplace_back(StageTime{e.stage});
-  s.work += ms;
-  s.longest = std::max(s.longest, ms);
-  if (e.serial) s.serial += ms;
-}
-
-WorkSpan toWorkSpan(StageTimes& stages) {
-  std::sort(stages.begin(), stages.end(), [](const StageTime& a, const StageTime& b) { return a.stage < b.stage; });
-  WorkSpan ws;
-  ws.stageWorkMs.reserve(stages.size());
-  ws.stageSpanMs.reserve(stages.size());
-  ws.stageIds.reserve(stages.size());
-  for (const StageTime& s : stages) {
-    const int32_t stage = s.stage;
-    const double span = std::max(s.longest, s.serial);
-    ws.workMs += s.work;
-    ws.spanMs += span;
-    ws.stageWorkMs.push_back(s.work);
-    ws.stageSpanMs.push_back(span);
-    ws.stageIds.push_back(stage);
+// A frame's zones summed stage by stage. Zones mostly come stage by stage, and a frame has a
+// few dozen stages: a search of the list from its end finds them. But a coloured island gives a
+// frame thousands of stages, a stage per colour and iteration, where that search was quadratic
+// (28 ms of demolition's 0.4 s run): past kListedStages the stages are found through a hash
+// table. (Sorting every zone by stage instead cost more on frames of few stages and many jobs.)
+class StageSums {
+ public:
+  void add(const ProfileEvent& e) {
+    if (stages_.empty() || stages_[last_].stage != e.stage) last_ = slot(e.stage);
+    StageTime& s = stages_[last_];
+    const double ms = double(e.endNs - e.beginNs) * 1e-6;
+    s.work += ms;
+    s.longest = std::max(s.longest, ms);
+    if (e.serial) s.serial += ms;
   }
-  ws.stages = int(stages.size());
-  return ws;
-}
+
+  WorkSpan workSpan() {
+    std::sort(stages_.begin(), stages_.end(), [](const StageTime& a, const StageTime& b) { return a.stage < b.stage; });
+    WorkSpan ws;
+    ws.stageWorkMs.reserve(stages_.size());
+    ws.stageSpanMs.reserve(stages_.size());
+    ws.stageIds.reserve(stages_.size());
+    for (const StageTime& s : stages_) {
+      const double span = std::max(s.longest, s.serial);
+      ws.workMs += s.work;
+      ws.spanMs += span;
+      ws.stageWorkMs.push_back(s.work);
+      ws.stageSpanMs.push_back(span);
+      ws.stageIds.push_back(s.stage);
+    }
+    ws.stages = int(stages_.size());
+    return ws;
+  }
+
+ private:
+  static constexpr size_t kListedStages = 128;
+  static constexpr uint32_t kEmpty = ~0u;
+  uint32_t slot(int32_t stage) {
+    if (index_.empty()) {
+      for (size_t k = stages_.size(); k-- > 0;)
+        if (stages_[k].stage == stage) return uint32_t(k);
+      stages_.push_back(StageTime{stage});
+      if (stages_.size() > kListedStages) rebuildIndex();
+      return uint32_t(stages_.size() - 1);
+    }
+    const size_t mask = index_.size() - 1;
+    for (size_t h = hash(stage) & mask;; h = (h + 1) & mask) {
+      if (index_[h] == kEmpty) {
+        index_[h] = uint32_t(stages_.size());
+        stages_.push_back(StageTime{stage});
+        if (stages_.size() * 2 > index_.size()) rebuildIndex();
+        return uint32_t(stages_.size() - 1);
+      }
+      if (stages_[index_[h]].stage == stage) return index_[h];
+    }
+  }
+  static size_t hash(int32_t stage) { return size_t((uint64_t(uint32_t(stage)) * 0x9E3779B97F4A7C15ull) >> 32); }
+  // An open-addressing table of stage slots (one allocation, not a node per stage: a frame of
+  // a few hundred stages made a node-based map cost more than the search it replaced).
+  void rebuildIndex() {
+    size_t size = 256;
+    while (size < stages_.size() * 4) size *= 2;
+    index_.assign(size, kEmpty);
+    for (size_t k = 0; k < stages_.size(); ++k) {
+      size_t h = hash(stages_[k].stage) & (size - 1);
+      while (index_[h] != kEmpty) h = (h + 1) & (size - 1);
+      index_[h] = uint32_t(k);
+    }
+  }
+  std::vector<StageTime> stages_;
+  std::vector<uint32_t> index_;  // once there are more than kListedStages
+  uint32_t last_ = 0;
+};
 }  // namespace
 
 std::vector<WorkSpan> Profiler::workSpans(uint32_t frames) const {
-  std::vector<StageTimes> perFrame(frames);
+  std::vector<StageSums> perFrame(frames);
   {
     std::lock_guard<std::mutex> lock(registry_);
     for (const auto& b : buffers_)
       for (const ProfileEvent& e : b->events)
-        if (e.frame < frames && e.stage >= 0) addZone(perFrame[e.frame], e);
+        if (e.frame < frames && e.stage >= 0) perFrame[e.frame].add(e);
   }
   std::vector<WorkSpan> out;
   out.reserve(frames);
-  for (StageTimes& stages : perFrame) out.push_back(toWorkSpan(stages));
+  for (StageSums& stages : perFrame) out.push_back(stages.workSpan());
   return out;
 }
 
 WorkSpan Profiler::workSpan(uint32_t frame) const {
-  StageTimes stages;
+  StageSums stages;
   std::lock_guard<std::mutex> lock(registry_);
   for (const auto& b : buffers_) {
     size_t begin = 0, end = b->events.size();
@@ -164,10 +207,10 @@ WorkSpan Profiler::workSpan(uint32_t frame) const {
     }
     for (size_t k = begin; k < end; ++k) {
       const ProfileEvent& e = b->events[k];
-      if (e.frame == frame && e.stage >= 0) addZone(stages, e);
+      if (e.frame == frame && e.stage >= 0) stages.add(e);
     }
   }
-  return toWorkSpan(stages);
+  return stages.workSpan();
 }
 
 void Profiler::writeChromeTrace(const std::string& path) const {

@@ -20,34 +20,81 @@ const char* insideSolidName(InsideSolid reason) {
   return "?";
 }
 
+template <class Visit>
+void World::visitSolidsReaching(const WorldAabb& box, Visit&& visit) const {
+  if (!solidIndexCurrent_) {
+    for (uint32_t g : solidBodies_)
+      if (mayOverlapSolid(g, box) && visit(g)) return;
+    return;
+  }
+  thread_local std::vector<uint32_t> solids;
+  solids.clear();
+  solidIndex_.any(box, [&](uint32_t g) {
+    solids.push_back(g);
+    return false;  // every one
+  });
+  std::sort(solids.begin(), solids.end());
+  for (uint32_t g : solids)
+    if (visit(g)) return;
+}
+
 InsideSolid World::pointInsideSolid(const Vec3d& p, uint32_t self, bool staticGrids) const {
   thread_local std::vector<uint32_t> candidates;
-  for (uint32_t g : solidBodies_) {
+  InsideSolid found = InsideSolid::No;
+  visitSolidsReaching(WorldAabb{p, p}, [&](uint32_t g) {
     const BodyShape& shape = bodies_.shape[g];
-    if (g == self || !mayOverlapSolid(g, WorldAabb{p, p})) continue;
-    if (!staticGrids && shape.isGrid() && bodies_.motion[g] == MotionType::Static) continue;
+    if (g == self) return false;
+    if (!staticGrids && shape.isGrid() && bodies_.motion[g] == MotionType::Static) return false;
     if (shape.isGrid()) {
       const BrickGrid& grid = *grids_[shape.grid];
       const Vec3f local = bodies_.shapePose(g).pointToLocal(p);
       candidates.clear();
       grid.overlapBricks(Aabb{local, local}, ~0u, candidates);
       for (uint32_t b : candidates)
-        if (brickContains(grid.brick(b), local)) return InsideSolid::InBrick;
+        if (brickContains(grid.brick(b), local)) found = InsideSolid::InBrick;
     } else if (shape.isTerrain()) {
       const Terrain& t = *terrains_[shape.terrain];
       const Vec3f v = t.placement().pointToLocal(p) / t.voxelSize();
       const Int3 cell{int(std::floor(v.x())), int(std::floor(v.y())), int(std::floor(v.z()))};
-      if (t.voxels().contains(cell) && t.voxels().get(cell).isSolid()) return InsideSolid::InVoxel;
+      if (t.voxels().contains(cell) && t.voxels().get(cell).isSolid()) found = InsideSolid::InVoxel;
     }
-  }
-  return InsideSolid::No;
+    return found != InsideSolid::No;
+  });
+  return found;
 }
+
+uint32_t World::soleSolidNear(const Vec3d& p, uint32_t self) const {
+  uint32_t found = kInvalidIndex, count = 0;
+  visitSolidsReaching(WorldAabb{p, p}, [&](uint32_t g) {
+    if (g == self) return false;
+    found = g;
+    return ++count > 1;
+  });
+  return count == 1 ? found : kInvalidIndex;
+}
+
+bool World::hasMovingSolid() const {
+  return std::any_of(solidBodies_.begin(), solidBodies_.end(), [&](uint32_t g) { return bodies_.motion[g] != MotionType::Static; });
+}
+
+void World::indexSolids() {
+  constexpr size_t kIndexFrom = 16;  // fewer solids: the loop over them costs less than the index
+  // Not before the first step or after poses were set (every solid is a candidate then), nor
+  // while a part split off between steps has no bounds yet.
+  if (solidIndexCurrent_ || !boundsCurrent_ || solidBodies_.size() < kIndexFrom || bounds_.size() < bodies_.size()) return;
+  std::vector<WorldAabb> boxes;
+  boxes.reserve(solidBodies_.size());
+  for (uint32_t g : solidBodies_) boxes.push_back(bounds_[g]);
+  solidIndex_.build(std::move(boxes), solidBodies_);
+  solidIndexCurrent_ = true;
+}
+
 
 // The solid body's broadphase bounds of the last substep hold it wherever it is now (they
 // cover its motion); before the first step, or after poses were set from outside, every solid
-// body is a candidate.
+// body is a candidate, and so is a part split off between steps (no bounds until the next).
 bool World::mayOverlapSolid(uint32_t solid, const WorldAabb& box) const {
-  return !boundsCurrent_ || bounds_[solid].overlaps(box);
+  return !boundsCurrent_ || solid >= bounds_.size() || bounds_[solid].overlaps(box);
 }
 
 uint64_t World::staticGridEdits() const {
@@ -63,15 +110,16 @@ bool World::segmentHitsStaticGrid(const Vec3d& from, const Vec3d& to) const {
   const double length = (to - from).norm();
   if (!(length > 0)) return false;
   const Vec3d dir = (to - from) / length;
-  for (uint32_t g : solidBodies_) {
+  bool hit = false;
+  visitSolidsReaching(WorldAabb{from.cwiseMin(to), from.cwiseMax(to)}, [&](uint32_t g) {
     const BodyShape& shape = bodies_.shape[g];
-    if (bodies_.motion[g] == MotionType::Dynamic || !shape.isGrid()) continue;
-    if (!mayOverlapSolid(g, WorldAabb{from.cwiseMin(to), from.cwiseMax(to)})) continue;
+    if (bodies_.motion[g] == MotionType::Dynamic || !shape.isGrid()) return false;
     const RigidTransform pose = bodies_.shapePose(g);
     const Ray ray = Ray::make(pose.pointToLocal(from), pose.directionToLocal(Vec3f(dir.cast<float>())), float(length));
-    if (grids_[shape.grid]->raycast(ray, ~0u).hit()) return true;
-  }
-  return false;
+    hit = grids_[shape.grid]->raycast(ray, ~0u).hit();
+    return hit;
+  });
+  return hit;
 }
 
 bool World::segmentHitsTerrain(const Vec3d& from, const Vec3d& to) {
@@ -87,20 +135,47 @@ bool World::segmentHitsTerrain(const Vec3d& from, const Vec3d& to) {
   return false;
 }
 
+// A moving solid alone near the body: its places move with it (static ones are the world's).
+uint32_t ContainmentTracker::frameAt(const Vec3d& p, uint32_t self) const {
+  if (!movingSolids_) return kWorldFrame;
+  const uint32_t g = world_.soleSolidNear(p, self);
+  return g != kInvalidIndex && world_.bodies().motion[g] != MotionType::Static ? g : kWorldFrame;
+}
+
+Vec3d ContainmentTracker::toSolidFrame(uint32_t solid, const Vec3d& p) const {
+  const BodyStore& bodies = world_.bodies();
+  return bodies.rotation[solid].cast<double>().conjugate() * (p - bodies.position[solid]);
+}
+
+Vec3d ContainmentTracker::fromSolidFrame(uint32_t solid, const Vec3d& q) const {
+  const BodyStore& bodies = world_.bodies();
+  return bodies.rotation[solid].cast<double>() * q + bodies.position[solid];
+}
+
 ContainmentTracker::ContainmentTracker(World& world) : world_(world) {
+  world.indexSolids();
+  movingSolids_ = world.hasMovingSolid();
   const BodyStore& bodies = world.bodies();
+  const uint32_t n = bodies.size();
+  seenFrame_.assign(n, kWorldFrame);
   lastSeen_.assign(bodies.position.begin(), bodies.position.end());
+  for (uint32_t i = 0; i < n; ++i)
+    if (bodies.motion[i] == MotionType::Dynamic) {
+      seenFrame_[i] = frameAt(bodies.position[i], i);
+      lastSeen_[i] = toFrame(seenFrame_[i], bodies.position[i]);
+    }
   staticEdits_ = world.staticGridEdits();
   lastClear_ = lastSeen_;
-  state_.assign(bodies.size(), InsideSolid::No);
-  for (uint32_t i = 0; i < bodies.size(); ++i)
+  clearFrame_ = seenFrame_;
+  state_.assign(n, InsideSolid::No);
+  for (uint32_t i = 0; i < n; ++i)
     if (bodies.motion[i] == MotionType::Dynamic) state_[i] = world.pointInsideSolid(bodies.position[i], i);
   // A body first seen inside solid (or kinematic, being pushed out of it) has no clear place
   // yet: the first place it is seen clear becomes one.
-  hasClear_.assign(bodies.size(), 0);
-  for (uint32_t i = 0; i < bodies.size(); ++i) hasClear_[i] = bodies.motion[i] == MotionType::Dynamic && state_[i] == InsideSolid::No;
+  hasClear_.assign(n, 0);
+  for (uint32_t i = 0; i < n; ++i) hasClear_[i] = bodies.motion[i] == MotionType::Dynamic && state_[i] == InsideSolid::No;
   report_ = {};
-  for (uint32_t i = 0; i < bodies.size(); ++i)
+  for (uint32_t i = 0; i < n; ++i)
     if (state_[i] != InsideSolid::No) {
       report_.bodies.push_back(i);
       report_.reasons.push_back(state_[i]);
@@ -114,34 +189,54 @@ const ContainmentReport& ContainmentTracker::update() {
   for (uint32_t i = uint32_t(lastSeen_.size()); i < n; ++i) {
     lastSeen_.push_back(bodies.position[i]);
     lastClear_.push_back(bodies.position[i]);
+    seenFrame_.push_back(kWorldFrame);
+    clearFrame_.push_back(kWorldFrame);
     state_.push_back(bodies.motion[i] == MotionType::Dynamic ? world_.pointInsideSolid(bodies.position[i], i) : InsideSolid::No);
     hasClear_.push_back(bodies.motion[i] == MotionType::Dynamic && state_.back() == InsideSolid::No);
   }
   // Pass 1, in parallel: the point test and the crossing test against grids (both only read)
   // for every body that needs a check; a crossing test against terrain (which fills chunk
   // caches) is left for pass 2.
+  world_.indexSolids();
+  movingSolids_ = world_.hasMovingSolid();
   checked_.assign(n, Check::None);
+  checkFrame_.resize(n);
+  checkPlace_.resize(n);
   const uint64_t edits = world_.staticGridEdits();
   const bool staticEdited = edits != staticEdits_;
   staticEdits_ = edits;
+  constexpr double kRecheck2 = kRecheckDistance * kRecheckDistance;
   JobSystem& jobs = world_.jobs();
   jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     for (uint32_t i = begin; i < end; ++i) {
       if (bodies.motion[i] != MotionType::Dynamic) continue;
       const Vec3d& p = bodies.position[i];
-      if (p == lastSeen_[i]) continue;
-      if (state_[i] == InsideSolid::No && !world_.nearSolidLastStep(i)) {
+      if (seenFrame_[i] == kWorldFrame && p == lastSeen_[i]) continue;
+      const bool clear = state_[i] == InsideSolid::No;
+      if (clear && !world_.nearSolidLastStep(i)) {
         checked_[i] = Check::FarFromSolid;
+        checkFrame_[i] = kWorldFrame;
+        checkPlace_[i] = p;
         continue;
       }
-      if (state_[i] == InsideSolid::No && hasClear_[i] && (p - lastSeen_[i]).squaredNorm() < kRecheckDistance * kRecheckDistance)
-        continue;  // at rest: checked again once it has moved further (from lastClear_ then)
+      // At rest (in the frame it was last seen in): checked again once it has moved further
+      // (from lastClear_ then). A body riding a moving grid must still have it alone near.
+      if (clear && hasClear_[i]) {
+        const uint32_t f = seenFrame_[i];
+        if (f == kWorldFrame ? (p - lastSeen_[i]).squaredNorm() < kRecheck2
+                             : (toFrame(f, p) - lastSeen_[i]).squaredNorm() < kRecheck2 && frameAt(p, i) == f)
+          continue;
+      }
+      const uint32_t frame = frameAt(p, i);
+      checkFrame_[i] = frame;
+      checkPlace_[i] = toFrame(frame, p);
+      const Vec3d from = fromFrame(clearFrame_[i], lastClear_[i]);
       // A centre inside a static grid's brick got there through the brick's surface, unless the
       // brick appeared around it (an edit): while static grids are unedited, the crossing test
       // from the last clear place answers for them, and the point test looks at the rest.
       const bool viaCrossing = hasClear_[i] && !staticEdited;
       InsideSolid s = world_.pointInsideSolid(p, i, !viaCrossing);
-      if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsStaticGrid(lastClear_[i], p))
+      if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsStaticGrid(from, p))
         s = viaCrossing && world_.pointInsideSolid(p, i) == InsideSolid::InBrick ? InsideSolid::InBrick : InsideSolid::WentThrough;
       checked_[i] = s == InsideSolid::InBrick   ? Check::InBrick
                     : s == InsideSolid::InVoxel ? Check::InVoxel
@@ -152,6 +247,7 @@ const ContainmentReport& ContainmentTracker::update() {
   // Pass 2, in body order: terrain crossings, then every checked body's state.
   report_.bodies.clear();
   report_.reasons.clear();
+  queried_ = 0;
   for (uint32_t i = 0; i < n; ++i) {
     const Vec3d& p = bodies.position[i];
     switch (checked_[i]) {
@@ -159,19 +255,24 @@ const ContainmentReport& ContainmentTracker::update() {
       case Check::FarFromSolid:
         // Clear before, and nowhere near a grid or terrain on its whole way here: clear now.
         lastSeen_[i] = lastClear_[i] = p;
+        seenFrame_[i] = clearFrame_[i] = kWorldFrame;
         hasClear_[i] = 1;
         break;
       default: {
+        ++queried_;
         InsideSolid s = checked_[i] == Check::InBrick ? InsideSolid::InBrick
                         : checked_[i] == Check::InVoxel ? InsideSolid::InVoxel
                         : checked_[i] == Check::WentThrough ? InsideSolid::WentThrough
                                                               : InsideSolid::No;
-        if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsTerrain(lastClear_[i], p)) s = InsideSolid::WentThrough;
+        if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsTerrain(fromFrame(clearFrame_[i], lastClear_[i]), p))
+          s = InsideSolid::WentThrough;
         if (s == InsideSolid::No) {
-          lastClear_[i] = p;
+          lastClear_[i] = checkPlace_[i];
+          clearFrame_[i] = checkFrame_[i];
           hasClear_[i] = 1;
         }
-        lastSeen_[i] = p;
+        lastSeen_[i] = checkPlace_[i];
+        seenFrame_[i] = checkFrame_[i];
         state_[i] = s;
       }
     }

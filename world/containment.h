@@ -48,8 +48,10 @@ struct ContainmentReport {
 /// bodies jitter by micrometres) is not checked again until it has: a centre that close to a
 /// clear place is at most that far into a brick (bodies rest with their centre a half extent
 /// from a surface), and the crossing test always runs from the last clear place, so no
-/// tunnelling is missed. Not while step() runs: it casts rays into
-/// the terrains, which fill their chunk caches.
+/// tunnelling is missed. A body whose only solid neighbour is a moving grid (a crate riding a
+/// kinematic ship) has those places kept in that grid's frame: resting on the ship it is at
+/// rest, and its path is the path relative to the ship. Not while step() runs: it casts rays
+/// into the terrains, which fill their chunk caches.
 class ContainmentTracker {
  public:
   /// Takes every dynamic body's current centre as its starting place (a body that starts
@@ -61,15 +63,29 @@ class ContainmentTracker {
   /// Checks every dynamic body that moved since the last update; returns the report.
   const ContainmentReport& update();
   const ContainmentReport& report() const { return report_; }
+  /// Bodies the last update() queried (point and path tests): what the shortcuts left.
+  uint32_t lastQueried() const { return queried_; }
 
  private:
   // What pass 1 of update() found for a body (pass 2 turns it into state).
   enum class Check : uint8_t { None, FarFromSolid, InBrick, InVoxel, WentThrough, ClearOfGrids };
+  // A body's places are kept in the world (kWorldFrame) or in a solid body's frame.
+  static constexpr uint32_t kWorldFrame = ~0u;
+  uint32_t frameAt(const Vec3d& p, uint32_t self) const;  // where a body at p keeps its places
+  Vec3d toFrame(uint32_t frame, const Vec3d& p) const { return frame == kWorldFrame ? p : toSolidFrame(frame, p); }
+  Vec3d fromFrame(uint32_t frame, const Vec3d& q) const { return frame == kWorldFrame ? q : fromSolidFrame(frame, q); }
+  Vec3d toSolidFrame(uint32_t solid, const Vec3d& p) const;    // world -> the solid's frame, at its current pose
+  Vec3d fromSolidFrame(uint32_t solid, const Vec3d& q) const;  // and back
+  bool movingSolids_ = false;  // World::hasMovingSolid() at the last update
   World& world_;
   std::vector<Check> checked_;
+  std::vector<uint32_t> checkFrame_;  // per body checked by this update: its frame, and
+  std::vector<Vec3d> checkPlace_;     // its centre in that frame
+  uint32_t queried_ = 0;
   uint64_t staticEdits_ = 0;  // World::staticGridEdits() at the last update
-  std::vector<Vec3d> lastSeen_;   // per body: centre when last checked (or found far from solid)
-  std::vector<Vec3d> lastClear_;  // per body: the last centre seen outside solid
+  std::vector<Vec3d> lastSeen_;   // per body: centre when last checked (or found far from solid), in seenFrame_
+  std::vector<Vec3d> lastClear_;  // per body: the last centre seen outside solid, in clearFrame_
+  std::vector<uint32_t> seenFrame_, clearFrame_;
   std::vector<uint8_t> hasClear_; // per body: lastClear_ is set (not for a body that started inside)
   std::vector<InsideSolid> state_;
   ContainmentReport report_;

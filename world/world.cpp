@@ -415,6 +415,7 @@ uint32_t World::addPartBody(std::unique_ptr<BrickGrid> grid, std::unique_ptr<Bri
   const uint32_t body = addGridBody(ng, pose.translation, pose.rotation, MotionType::Dynamic, v.cast<double>(), w);
   gridBodies_.push_back({body});
   solidBodies_.push_back(body);
+  solidIndexCurrent_ = false;
   nearSolid_.push_back(1);
   ghost_.push_back(0);  // note: read for every pair while some body depenetrates (a part made then overran it)
   sleep_.grow(bodies_.size());
@@ -505,6 +506,7 @@ void World::applyFrameEdits() {
 void World::step() {
   const auto t = Clock::now();
   stats_ = StepStats{};
+  solidIndexCurrent_ = false;
   nearSolid_.assign(bodies_.size(), 0);
   profiler_.beginFrame(frame_);
   runEdits();
@@ -553,6 +555,7 @@ void World::setPoses(const std::vector<Vec3d>& positions, const std::vector<Quat
   // Moved from outside: no step vouches for where bodies went (containment checks them all).
   nearSolid_.assign(n, 1);
   boundsCurrent_ = false;
+  solidIndexCurrent_ = false;
 }
 
 uint64_t World::stateHash() const {

@@ -176,6 +176,19 @@ class World {
   /// staticGrids false leaves static grids out (the containment tracker tests them by the
   /// path instead while they are unedited).
   InsideSolid pointInsideSolid(const Vec3d& p, uint32_t self, bool staticGrids = true) const;
+  /// The one grid or terrain body (not `self`) whose last broadphase bounds hold point `p`
+  /// (world), or kInvalidIndex when none or several do: the containment tracker keeps the
+  /// places of a body riding a moving grid in that grid's frame.
+  uint32_t soleSolidNear(const Vec3d& p, uint32_t self) const;
+  /// Sorts the solid bodies' reach (their last broadphase bounds) along x, so that the point
+  /// and path queries above visit only the solids that can reach them (a fleet of 1,500 grid
+  /// ships: every containment query looped over all of them). Between steps, on one thread;
+  /// step(), setPoses() and a part splitting off make it stale (the queries then visit every
+  /// solid, as before the first call). Worlds of a few solids are not indexed.
+  void indexSolids();
+  /// Whether a grid or terrain body is kinematic or dynamic (containment follows bodies in the
+  /// frames of those only).
+  bool hasMovingSolid() const;
   /// Sum of the static grids' edit counts: changes whenever one is edited.
   uint64_t staticGridEdits() const;
   /// Whether the segment from `from` to `to` (world) crosses a static or kinematic grid or a
@@ -254,6 +267,10 @@ class World {
   void markNearSolid(uint32_t pair);
   /// Whether solid body `solid` can reach into `box` (its last broadphase bounds overlap it).
   bool mayOverlapSolid(uint32_t solid, const WorldAabb& box) const;
+  /// Calls visit(solid) for the solid bodies that may reach into `box`, ascending, until it
+  /// returns true (indexSolids()); defined in containment.cpp, its only user.
+  template <class Visit>
+  void visitSolidsReaching(const WorldAabb& box, Visit&& visit) const;
   /// A grid or terrain body (what another body can be inside of).
   bool isSolid(uint32_t body) const { return bodies_.shape[body].isGrid() || bodies_.shape[body].isTerrain(); }
   /// The fastest the pair's surfaces can approach (m/s): relative speed plus both spins times radii.
@@ -319,6 +336,8 @@ class World {
   std::vector<uint8_t> nearSolid_;     // per body: came near a grid or terrain in this step (containment's filter)
   bool boundsCurrent_ = false;         // bounds_ hold every body as it is now (a step ran, no setPoses since)
   std::vector<uint32_t> solidBodies_;  // grid and terrain bodies, ascending (what bodies can be inside)
+  BodyBoxIndex solidIndex_;            // solidBodies_' reach, when solidIndexCurrent_ (indexSolids())
+  bool solidIndexCurrent_ = false;
   std::vector<Depenetration> depenetrating_;
   std::vector<uint8_t> ghost_;  // per body: on its way out of solid (collides with nothing)
   uint32_t startedInSolid_ = 0;

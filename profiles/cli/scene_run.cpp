@@ -279,6 +279,7 @@ int runScene(const SceneRunOptions& o) {
   }
   const auto tRun = Clock::now();
   double simulationMs = 0;  // the steps' own time; the rest of the run is bookkeeping
+  uint64_t containmentQueries = 0;  // bodies the containment checks queried (what its shortcuts left)
   for (uint32_t f = 0; f < frames; ++f) {
     if (o.driftAfter && f == o.driftAfter) settled = world.bodies().position;
     watch.begin("frame", f + 1, frames);
@@ -287,6 +288,7 @@ int runScene(const SceneRunOptions& o) {
     const StepStats& s = world.lastStats();
     simulationMs += s.totalMs;
     containment.update();
+    containmentQueries += containment.lastQueried();
     checks.update();
     if (recording) recording->frame(world, containment.report());
     endDeepest = deepestContact(world);
@@ -396,7 +398,8 @@ int runScene(const SceneRunOptions& o) {
                      {"state_hash", world.stateHash()},
                      {"simulation_ms", simulationMs},
                      {"bookkeeping_ms", bookkeepingMs},
-                     {"bookkeeping_share", bookkeepingMs / std::max(simulationMs, 1e-9)}};
+                     {"bookkeeping_share", bookkeepingMs / std::max(simulationMs, 1e-9)},
+                     {"containment_queries_per_frame", double(containmentQueries) / std::max(frames, 1u)}};
     if (inside.count()) j["inside_solid"] = insideSolidList(inside, bodies.position);
     if (checks.any()) j["checks"] = checksJson(checks);
     if (recording) j["recording"] = {{"file", o.recordPath}, {"frames", recording->frames()}, {"bytes_uncompressed", recording->bytes()}};

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <set>
 
 #include "jobs/job_system.h"
@@ -69,6 +70,51 @@ TEST(Profiler, OneFramesWorkSpanEqualsTheWholeRunPassInAnyFrameOrder) {
     }
     EXPECT_EQ(p.workSpan(frames + 3).workMs, 0.0);
   }
+}
+
+TEST(Profiler, ThousandsOfInterleavedStagesSumLikeAMapPerStage) {
+  // A coloured island's frame: thousands of stages (ids up to 2^27, as the solver's waves give
+  // them), zones of one stage scattered among others; each stage's work, longest and serial
+  // zones against a std::map of the same zones.
+  Profiler p;
+  uint64_t x = 12345;
+  const auto next = [&x] {
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    return x;
+  };
+  struct Sums {
+    double work = 0, longest = 0, serial = 0;
+  };
+  std::map<int32_t, Sums> expected;
+  p.beginFrame(2);
+  for (int z = 0; z < 20000; ++z) {
+    const int32_t stage = next() % 4 == 0 ? int32_t(next() % 40) : (1 << 20) + int32_t(next() % 1500) * 65536 + int32_t(next() % 3);
+    const int64_t begin = int64_t(next() % 1000000), length = int64_t(next() % 50000);
+    const bool serial = next() % 5 == 0;
+    p.record("zone", begin, begin + length, stage, serial);
+    Sums& s = expected[stage];
+    const double ms = double(length) * 1e-6;
+    s.work += ms;
+    s.longest = std::max(s.longest, ms);
+    if (serial) s.serial += ms;
+  }
+  const WorkSpan ws = p.workSpan(2);
+  ASSERT_EQ(ws.stageIds.size(), expected.size());
+  double work = 0, span = 0;
+  size_t k = 0;
+  for (const auto& [stage, s] : expected) {
+    ASSERT_EQ(ws.stageIds[k], stage);
+    EXPECT_NEAR(ws.stageWorkMs[k], s.work, 1e-9 * s.work);
+    EXPECT_DOUBLE_EQ(ws.stageSpanMs[k], std::max(s.longest, s.serial)) << "stage " << stage;
+    work += s.work;
+    span += std::max(s.longest, s.serial);
+    ++k;
+  }
+  EXPECT_NEAR(ws.workMs, work, 1e-9 * work);
+  EXPECT_NEAR(ws.spanMs, span, 1e-9 * span);
+  EXPECT_GT(expected.size(), 3000u);
 }
 
 TEST(Profiler, ZonesFromManyThreadsGoToATraceThatParses) {

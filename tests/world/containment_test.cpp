@@ -2,8 +2,10 @@
 // onto a floor of thin plates never end up inside a brick or below the floor they landed on.
 #include <algorithm>
 #include <cstdio>
+#include <string>
 #include <gtest/gtest.h>
 
+#include "collision/core/seeded_random.h"
 #include "world/containment.h"
 #include "world/world.h"
 
@@ -125,6 +127,128 @@ TEST(Containment, ShortcutsReportWhatCheckingEveryBodyEveryFrameReports) {
     framesWithBodiesInside += expected.empty() ? 0 : 1;
   }
   EXPECT_GE(framesWithBodiesInside, 50u);  // the placed brick and the teleport are seen
+}
+
+// A crate riding a kinematic deck (4 m/s, a wall across the deck behind the crate) is followed
+// in the deck's frame: at rest on it, it is not queried again; the path of a nudge is the path
+// relative to the deck (from its last clear place in world coordinates, that path would cross the
+// wall the deck carried past it); a teleport under the deck is a path through it.
+TEST(Containment, ACrateRidingAKinematicDeckIsFollowedInTheDecksFrame) {
+  SceneDescription scene;
+  scene.name = "deck_ride";
+  GridDescription deck;
+  deck.name = "deck";
+  deck.motion = MotionType::Kinematic;
+  deck.kinematic.linearVelocity = Vec3d(4, 0, 0);
+  for (int x = 0; x < 20; ++x)
+    for (int y = 0; y < 4; ++y) deck.bricks.push_back(Brick::box(Vec3f(float(x) + 0.5f, float(y) + 0.5f, -0.05f), Vec3f(0.5f, 0.5f, 0.05f)));
+  deck.bricks.push_back(Brick::box(Vec3f(3.f, 2.f, 0.5f), Vec3f(0.1f, 2.f, 0.5f)));  // the wall, 2 m behind the crate
+  scene.grids.push_back(deck);
+  SpawnerDescription crate;
+  crate.shape = SpawnerDescription::Shape::Box;
+  crate.count = 1;
+  crate.regionMin = crate.regionMax = Vec3d(5, 2, 0.26);
+  crate.halfExtents = Vec3f::Constant(0.25f);
+  crate.velocity = Vec3d(4, 0, 0);
+  scene.spawners.push_back(crate);
+  World world(scene, 2);
+  const BodyStore& bodies = world.bodies();
+  const uint32_t body = 1;
+  ASSERT_EQ(bodies.motion[body], MotionType::Dynamic);
+  ContainmentTracker tracker(world);
+  uint32_t queriedLate = 0;
+  for (int f = 0; f < 120; ++f) {
+    world.step();
+    ASSERT_EQ(tracker.update().count(), 0u) << "frame " << f;
+    if (f >= 60) queriedLate += tracker.lastQueried();
+  }
+  // It rode along (moved 8 m in the world, still 0.25 m above the deck near where it landed).
+  const Vec3d onDeck = bodies.rotation[0].cast<double>().conjugate() * (bodies.position[body] - bodies.position[0]);
+  EXPECT_GT(bodies.position[body].x(), 12.0);
+  EXPECT_NEAR(onDeck.x(), 5.0, 0.15);
+  EXPECT_NEAR(onDeck.z(), 0.25, 0.01);
+  // Resting, it creeps by micrometres a frame: queried again only after each half millimetre
+  // (in the world's frame it moved 6.7 cm every frame: 60 queries).
+  EXPECT_LE(queriedLate, 2u) << "a crate at rest on the deck was queried again and again";
+
+  // A 1 mm nudge along the deck: checked, and clear (the path on the deck crosses nothing).
+  std::vector<Vec3d> positions(bodies.position.begin(), bodies.position.end());
+  std::vector<Quatf> rotations(bodies.rotation.begin(), bodies.rotation.end());
+  positions[body].x() += 1e-3;
+  world.setPoses(positions, rotations);
+  EXPECT_EQ(tracker.update().count(), 0u);
+  EXPECT_EQ(tracker.lastQueried(), 1u);
+  // The world-frame path from where it was last clear crosses the wall the deck carried past it.
+  EXPECT_TRUE(world.segmentHitsStatic(positions[body] - Vec3d(4.0, 0, 0), positions[body]));
+
+  // Set under the deck: its path relative to the deck goes through the deck's plates.
+  positions[body].z() -= 0.5;
+  world.setPoses(positions, rotations);
+  const ContainmentReport& r = tracker.update();
+  ASSERT_EQ(r.count(), 1u);
+  EXPECT_EQ(r.reasons[0], InsideSolid::WentThrough);
+}
+
+// The solids' index (World::indexSolids) changes no answer: 40 small grids (static, kinematic
+// and a dynamic one falling) with crates raining through them, 10 km from the origin; random
+// points and segments near them queried with the index and without (the loop over every solid).
+TEST(Containment, TheSolidsIndexAnswersLikeTheLoopOverEverySolid) {
+  SceneDescription scene;
+  scene.name = "many_solids";
+  const Vec3d origin(1e4, -1e4, 0);
+  SeededRandom rng(17);
+  for (int k = 0; k < 40; ++k) {
+    GridDescription g;
+    g.name = "g" + std::to_string(k);
+    g.position = origin + Vec3d(rng.uniform(0, 60), rng.uniform(0, 60), rng.uniform(0, 20));
+    g.motion = k % 3 == 0 ? MotionType::Kinematic : k == 7 ? MotionType::Dynamic : MotionType::Static;
+    g.kinematic.linearVelocity = Vec3d(rng.uniform(-3, 3), rng.uniform(-3, 3), 0);
+    for (int b = 0; b < 12; ++b)
+      g.bricks.push_back(Brick::box(Vec3f(float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)), float(rng.uniform(-1, 1))),
+                                    Vec3f(float(rng.uniform(0.1, 1.5)), float(rng.uniform(0.1, 1.5)), float(rng.uniform(0.05, 0.6)))));
+    scene.grids.push_back(g);
+  }
+  SpawnerDescription rain;
+  rain.count = 200;
+  rain.seed = 3;
+  rain.regionMin = origin + Vec3d(0, 0, 25);
+  rain.regionMax = origin + Vec3d(60, 60, 40);
+  scene.spawners.push_back(rain);
+  World world(scene, 2);
+  uint32_t inside = 0, hits = 0, sole = 0;
+  for (int f = 0; f < 40; ++f) {
+    world.step();
+    std::vector<Vec3d> points, ends;
+    for (int q = 0; q < 400; ++q) {
+      // Half near a grid's centre (inside its bricks often), half anywhere around them.
+      const Vec3d around = world.bodies().position[uint32_t(rng.uniform(0, 39.99))];
+      points.push_back(q % 2 ? around + Vec3d(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-1, 1))
+                             : origin + Vec3d(rng.uniform(-5, 65), rng.uniform(-5, 65), rng.uniform(-3, 25)));
+      ends.push_back(points.back() + Vec3d(rng.uniform(-4, 4), rng.uniform(-4, 4), rng.uniform(-4, 4)));
+    }
+    std::vector<InsideSolid> in;
+    std::vector<uint8_t> hit;
+    std::vector<uint32_t> near;
+    for (size_t q = 0; q < points.size(); ++q) {
+      in.push_back(world.pointInsideSolid(points[q], kInvalidIndex));
+      hit.push_back(world.segmentHitsStaticGrid(points[q], ends[q]));
+      near.push_back(world.soleSolidNear(points[q], 40));
+    }
+    world.indexSolids();
+    for (size_t q = 0; q < points.size(); ++q) {
+      ASSERT_EQ(world.pointInsideSolid(points[q], kInvalidIndex), in[q]) << "frame " << f << " point " << q;
+      ASSERT_EQ(world.segmentHitsStaticGrid(points[q], ends[q]), hit[q] != 0) << "frame " << f << " segment " << q;
+      ASSERT_EQ(world.soleSolidNear(points[q], 40), near[q]) << "frame " << f << " point " << q;
+      inside += in[q] != InsideSolid::No;
+      hits += hit[q];
+      sole += near[q] != kInvalidIndex;
+    }
+  }
+  // The comparison meant something: points inside bricks, segments through them, points near one grid.
+  std::printf("[ containment ] %u points inside, %u segments hit, %u points near one solid\n", inside, hits, sole);
+  EXPECT_GT(inside, 500u);
+  EXPECT_GT(hits, 1000u);
+  EXPECT_GT(sole, 2000u);
 }
 
 }  // namespace
