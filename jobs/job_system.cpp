@@ -129,6 +129,56 @@ void JobSystem::parallelFor(uint32_t begin, uint32_t end, uint32_t grain,
   impl_->parallel(chunks, chunk);
 }
 
+namespace {
+// Waiting for another thread's chunk: a short spin (the chunk is microseconds), then yields so
+// that a run with more threads than cores lets the running thread finish it.
+void backOff(uint32_t spins) {
+  if (spins < 64) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  } else {
+    std::this_thread::yield();
+  }
+}
+
+// One wave's counters, on a cache line of their own (every thread takes chunks from them).
+struct alignas(64) WaveCounters {
+  std::atomic<uint32_t> taken{0}, finished{0};
+};
+}  // namespace
+
+void JobSystem::parallelWaves(const std::vector<uint32_t>& chunksOf, const std::function<void(uint32_t, uint32_t)>& body) {
+  const uint32_t waves = uint32_t(chunksOf.size());
+  if (threads_ == 1) {
+    for (uint32_t w = 0; w < waves; ++w)
+      for (uint32_t c = 0; c < chunksOf[w]; ++c) body(w, c);
+    return;
+  }
+  std::unique_ptr<WaveCounters[]> counters(new WaveCounters[waves]);
+  std::atomic<uint32_t> completed{0};  // waves [0, completed) are finished
+  const auto member = [&](uint32_t) {
+    for (uint32_t w = 0; w < waves; ++w) {
+      for (uint32_t spins = 0; completed.load(std::memory_order_acquire) < w; ++spins) backOff(spins);
+      if (chunksOf[w] == 0) {  // nothing to run: the first thread here finishes it
+        uint32_t expected = w;
+        completed.compare_exchange_strong(expected, w + 1, std::memory_order_acq_rel);
+        continue;
+      }
+      for (;;) {
+        const uint32_t c = counters[w].taken.fetch_add(1, std::memory_order_relaxed);
+        if (c >= chunksOf[w]) break;
+        body(w, c);
+        // The last chunk's thread opens the next wave; its release (after every finisher's,
+        // through the counter) makes the wave's writes visible to whoever takes the next one.
+        if (counters[w].finished.fetch_add(1, std::memory_order_acq_rel) + 1 == chunksOf[w])
+          completed.store(w + 1, std::memory_order_release);
+      }
+    }
+  };
+  impl_->parallel(uint32_t(threads_), member);
+}
+
 void JobSystem::run(const std::function<void()>& f) { impl_->run(f); }
 
 }  // namespace bw

@@ -40,6 +40,15 @@ class JobSystem {
     return end > begin ? (end - begin + grain - 1) / grain : 0;
   }
 
+  /// Runs `waves` waves in order, wave w as chunksOf[w] chunks in parallel (body(w, chunk)),
+  /// each wave starting once every chunk of the one before has finished: what parallelFor
+  /// once per wave would do, but in one parallel region whose threads pass from wave to wave
+  /// through atomic counters (a coloured island's 8 iterations of 20-60 colours were as many
+  /// fork-joins). A thread that finds a wave's chunks all taken waits for the wave to finish
+  /// (spinning, then yielding); the thread that took a chunk is running it, so the waves finish
+  /// even when fewer threads than asked ever arrive. body must not call this JobSystem.
+  void parallelWaves(const std::vector<uint32_t>& chunksOf, const std::function<void(uint32_t, uint32_t)>& body);
+
   /// Runs f inside this system's arena (so nested TBB algorithms use its thread count).
   void run(const std::function<void()>& f);
 

@@ -302,29 +302,45 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, const
     colouring_.colour(island, contacts_, motion);
     colours = colouring_.colours();
   }
-  // One pass over the colours in order: each colour's contacts in parallel (no two share a
-  // dynamic body), the serial group last, on one thread.
-  const auto wavePass = [&](const char* zoneName, bool reversed, auto&& perContact) {
+  // Every pass over the colours in order, as waves of one parallel region: each colour's
+  // contacts in parallel (no two share a dynamic body), the serial group as one chunk. A
+  // wave starts when the one before has finished, as a fork-join per colour would, without
+  // a fork-join's wake and wait per colour (which made chunks finer than 64 contacts cost
+  // more than they saved on two threads; world_tuning.h).
+  struct Wave {
+    uint32_t colour;
+    int32_t stageId;
+    bool warmStart;
+  };
+  std::vector<Wave> waves;
+  std::vector<uint32_t> chunks;
+  const auto pass = [&](bool warmStart, bool reversed) {
     for (uint32_t i = 0; i < colours; ++i) {
       const uint32_t c = reversed ? colours - 1 - i : i;
-      const std::span<const uint32_t> group = colouring_.colour(c);
-      const int32_t waveId = waveStage(stage, wave);
-      if (c == kMaxColours) {  // the serial group: contacts may share bodies
-        ProfileZone zone(profiler, zoneName, waveId, true);
-        for (uint32_t k : group) perContact(contacts_[k]);
-        continue;
-      }
-      jobs.parallelFor(0, uint32_t(group.size()), kColourGrain, [&](uint32_t cb, uint32_t ce) {
-        ProfileZone zone(profiler, zoneName, waveId);
-        for (uint32_t j = cb; j < ce; ++j) perContact(contacts_[group[j]]);
-      });
+      waves.push_back({c, waveStage(stage, wave), warmStart});
+      const uint32_t size = uint32_t(colouring_.colour(c).size());
+      chunks.push_back(c == kMaxColours ? (size > 0 ? 1u : 0u) : JobSystem::chunkCount(0, size, kColourGrain));
     }
   };
   // note: colour by colour, each body gets its contacts' warm-start impulses in the order of
   // colouring_.all(), as a serial pass over it would: the result is the same.
-  if (!relax) wavePass("warm start", false, [&](SolverContact& s) { warmStart(s); });
+  if (!relax) pass(true, false);
   const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
-  for (int it = 0; it < iterations; ++it) wavePass(name, it & 1, [&](SolverContact& s) { solveContact(s, relax); });
+  for (int it = 0; it < iterations; ++it) pass(false, it & 1);
+  jobs.parallelWaves(chunks, [&](uint32_t w, uint32_t chunk) {
+    const Wave& v = waves[w];
+    const std::span<const uint32_t> group = colouring_.colour(v.colour);
+    const bool serial = v.colour == kMaxColours;  // the serial group: contacts may share bodies
+    const uint32_t begin = serial ? 0 : chunk * kColourGrain;
+    const uint32_t end = serial ? uint32_t(group.size()) : std::min(uint32_t(group.size()), begin + kColourGrain);
+    ProfileZone zone(profiler, v.warmStart ? "warm start" : name, v.stageId, serial);
+    for (uint32_t j = begin; j < end; ++j) {
+      if (v.warmStart)
+        warmStart(contacts_[group[j]]);
+      else
+        solveContact(contacts_[group[j]], relax);
+    }
+  });
   if (!relax && settings.shockPropagation) {  // one serial sweep over the whole pile
     ProfileZone zone(profiler, "shock sweep", waveStage(stage, wave), true);
     std::vector<uint32_t> list(colouring_.all().begin(), colouring_.all().end());

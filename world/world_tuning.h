@@ -114,10 +114,13 @@ inline constexpr uint32_t kSplitContacts = 512;
 /// serial group.
 inline constexpr uint32_t kMaxColours = 64;
 /// Contacts per job when a colour is solved in parallel. Finer cuts shorten the chain of colours
-/// a many-threaded machine waits on (crate_pile's bound at 16 threads: 9.3x at 64, 11x at 32,
-/// 12x at 16) but cost more than they save on two (measured 1.63-1.81x at 64, 1.28-1.33x at 32
-/// and 16: neighbouring contacts' bodies shared between the threads' cache lines), so 64.
-inline constexpr uint32_t kColourGrain = 64;
+/// a many-threaded machine waits on (crate_pile's bound at 16 threads: 8.6-8.8x at 64,
+/// 10.4-10.7x at 32, 11.5-11.7x at 16). With a fork-join per colour they cost more than they
+/// saved on two threads (1.28-1.33x at 32 and 16 against 1.63-1.81x at 64, session 8); since
+/// the colours run as waves of one parallel region (JobSystem::parallelWaves) 32 measures as 64
+/// did (1.72-1.75x, session 18), and 16 a little under (1.66-1.76x) with its chunks of ~0.6 us
+/// near what a wave's hand-over costs.
+inline constexpr uint32_t kColourGrain = 32;
 /// Fewest pairs per job of the step's counters (a few loads and adds per pair).
 inline constexpr uint32_t kMinCounterGrain = 256;
 /// Pairs per job in contact generation (a pair may be a grid query of many bricks).

@@ -43,6 +43,45 @@ TEST(JobSystem, EveryItemOnceAndDeterministicAcrossThreadCounts) {
   }
 }
 
+// parallelWaves: wave w's chunks split row w+1 and read row w anywhere (each slot from two of
+// the wave before, one of them another chunk's), as a colour reads the bodies the colour before
+// moved: a wave that started early, or a write not yet visible, changes the rows. Waves of 0,
+// 1 and many chunks; 1 to 16 threads against a serial reference; every chunk run once.
+TEST(JobSystem, WavesRunInOrderAndSeeTheWaveBefore) {
+  constexpr uint32_t kSlots = 96;
+  std::vector<uint32_t> chunksOf;
+  for (uint32_t w = 0; w < 300; ++w) chunksOf.push_back(w % 7 == 3 ? 0u : w % 5 == 0 ? 1u : 1u + (w * 13) % 12);
+  const uint32_t waves = uint32_t(chunksOf.size());
+  const auto step = [&](const std::vector<uint64_t>& row, std::vector<uint64_t>& into, uint32_t w, uint32_t c) {
+    const uint32_t n = chunksOf[w];
+    for (uint32_t i = kSlots * c / n; i < kSlots * (c + 1) / n; ++i)
+      into[i] = row[i] * 6364136223846793005ull + row[(i + 1 + 7 * w) % kSlots] + w;
+  };
+  std::vector<std::vector<uint64_t>> expected(waves + 1, std::vector<uint64_t>(kSlots, 0));
+  for (uint32_t i = 0; i < kSlots; ++i) expected[0][i] = i * 2654435761ull;
+  for (uint32_t w = 0; w < waves; ++w)
+    for (uint32_t c = 0; c < chunksOf[w]; ++c) step(expected[w], expected[w + 1], w, c);
+  std::vector<uint32_t> firstChunk(waves + 1, 0);
+  for (uint32_t w = 0; w < waves; ++w) firstChunk[w + 1] = firstChunk[w] + chunksOf[w];
+  for (int threads : {1, 2, 4, 16}) {
+    JobSystem jobs(threads);
+    for (int repeat = 0; repeat < 5; ++repeat) {
+      std::vector<std::vector<uint64_t>> rows(waves + 1, std::vector<uint64_t>(kSlots, 0));
+      rows[0] = expected[0];
+      std::vector<std::atomic<uint32_t>> runs(firstChunk[waves]);
+      jobs.parallelWaves(chunksOf, [&](uint32_t w, uint32_t c) {
+        runs[firstChunk[w] + c].fetch_add(1, std::memory_order_relaxed);
+        step(rows[w], rows[w + 1], w, c);
+      });
+      for (uint32_t k = 0; k < firstChunk[waves]; ++k) ASSERT_EQ(runs[k].load(), 1u) << threads << " threads, chunk " << k;
+      ASSERT_EQ(rows, expected) << threads << " threads";
+    }
+  }
+  JobSystem jobs(4);
+  jobs.parallelWaves({}, [](uint32_t, uint32_t) { FAIL() << "no waves, no chunks"; });
+  jobs.parallelWaves({0, 0, 0}, [](uint32_t, uint32_t) { FAIL() << "empty waves, no chunks"; });
+}
+
 TEST(JobSystem, EmptyRangesAndBadThreadCounts) {
   JobSystem jobs(2);
   int calls = 0;
