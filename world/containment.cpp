@@ -63,9 +63,9 @@ InsideSolid World::pointInsideSolid(const Vec3d& p, uint32_t self, bool staticGr
   return found;
 }
 
-uint32_t World::soleSolidNear(const Vec3d& p, uint32_t self) const {
+uint32_t World::soleSolidReaching(const WorldAabb& box, uint32_t self) const {
   uint32_t found = kInvalidIndex, count = 0;
-  visitSolidsReaching(WorldAabb{p, p}, [&](uint32_t g) {
+  visitSolidsReaching(box, [&](uint32_t g) {
     if (g == self) return false;
     found = g;
     return ++count > 1;
@@ -106,14 +106,14 @@ uint64_t World::staticGridEdits() const {
 
 bool World::segmentHitsStatic(const Vec3d& from, const Vec3d& to) { return segmentHitsStaticGrid(from, to) || segmentHitsTerrain(from, to); }
 
-bool World::segmentHitsStaticGrid(const Vec3d& from, const Vec3d& to) const {
+bool World::segmentHitsStaticGrid(const Vec3d& from, const Vec3d& to, uint32_t only, uint32_t except) const {
   const double length = (to - from).norm();
   if (!(length > 0)) return false;
   const Vec3d dir = (to - from) / length;
   bool hit = false;
   visitSolidsReaching(WorldAabb{from.cwiseMin(to), from.cwiseMax(to)}, [&](uint32_t g) {
     const BodyShape& shape = bodies_.shape[g];
-    if (bodies_.motion[g] == MotionType::Dynamic || !shape.isGrid()) return false;
+    if (bodies_.motion[g] == MotionType::Dynamic || !shape.isGrid() || g == except || (only != kInvalidIndex && g != only)) return false;
     const RigidTransform pose = bodies_.shapePose(g);
     const Ray ray = Ray::make(pose.pointToLocal(from), pose.directionToLocal(Vec3f(dir.cast<float>())), float(length));
     hit = grids_[shape.grid]->raycast(ray, ~0u).hit();
@@ -135,21 +135,34 @@ bool World::segmentHitsTerrain(const Vec3d& from, const Vec3d& to) {
   return false;
 }
 
-// A moving solid alone near the body: its places move with it (static ones are the world's).
-uint32_t ContainmentTracker::frameAt(const Vec3d& p, uint32_t self) const {
+// A moving solid alone reaching the box: the places of a body there move with it (static
+// ones are the world's).
+uint32_t ContainmentTracker::frameAt(const WorldAabb& box, uint32_t self) const {
   if (!movingSolids_) return kWorldFrame;
-  const uint32_t g = world_.soleSolidNear(p, self);
+  const uint32_t g = world_.soleSolidReaching(box, self);
   return g != kInvalidIndex && world_.bodies().motion[g] != MotionType::Static ? g : kWorldFrame;
 }
 
+// The solid's shape frame, not its body frame: a dynamic grid's body frame is its centre of
+// mass and principal axes, which move over its bricks when it is edited.
 Vec3d ContainmentTracker::toSolidFrame(uint32_t solid, const Vec3d& p) const {
-  const BodyStore& bodies = world_.bodies();
-  return bodies.rotation[solid].cast<double>().conjugate() * (p - bodies.position[solid]);
+  const RigidTransform pose = world_.bodies().shapePose(solid);
+  return pose.rotation.cast<double>().conjugate() * (p - pose.translation);
 }
 
 Vec3d ContainmentTracker::fromSolidFrame(uint32_t solid, const Vec3d& q) const {
-  const BodyStore& bodies = world_.bodies();
-  return bodies.rotation[solid].cast<double>() * q + bodies.position[solid];
+  const RigidTransform pose = world_.bodies().shapePose(solid);
+  return pose.rotation.cast<double>() * q + pose.translation;
+}
+
+// The crossing test against grids from the body's last clear place: in the world, or, kept in
+// a moving grid's frame, against that grid from there and against the others from where it
+// was last clear of them in the world.
+bool ContainmentTracker::crossesGrid(uint32_t body, const Vec3d& p) const {
+  const uint32_t f = clearFrame_[body];
+  if (f == kWorldFrame) return world_.segmentHitsStaticGrid(lastClear_[body], p);
+  return world_.segmentHitsStaticGrid(fromSolidFrame(f, lastClear_[body]), p, f) ||
+         world_.segmentHitsStaticGrid(lastClearWorld_[body], p, kInvalidIndex, f);
 }
 
 ContainmentTracker::ContainmentTracker(World& world) : world_(world) {
@@ -159,9 +172,10 @@ ContainmentTracker::ContainmentTracker(World& world) : world_(world) {
   const uint32_t n = bodies.size();
   seenFrame_.assign(n, kWorldFrame);
   lastSeen_.assign(bodies.position.begin(), bodies.position.end());
+  lastWorld_ = lastClearWorld_ = lastSeen_;
   for (uint32_t i = 0; i < n; ++i)
     if (bodies.motion[i] == MotionType::Dynamic) {
-      seenFrame_[i] = frameAt(bodies.position[i], i);
+      seenFrame_[i] = frameAt(WorldAabb{bodies.position[i], bodies.position[i]}, i);
       lastSeen_[i] = toFrame(seenFrame_[i], bodies.position[i]);
     }
   staticEdits_ = world.staticGridEdits();
@@ -189,6 +203,8 @@ const ContainmentReport& ContainmentTracker::update() {
   for (uint32_t i = uint32_t(lastSeen_.size()); i < n; ++i) {
     lastSeen_.push_back(bodies.position[i]);
     lastClear_.push_back(bodies.position[i]);
+    lastWorld_.push_back(bodies.position[i]);
+    lastClearWorld_.push_back(bodies.position[i]);
     seenFrame_.push_back(kWorldFrame);
     clearFrame_.push_back(kWorldFrame);
     state_.push_back(bodies.motion[i] == MotionType::Dynamic ? world_.pointInsideSolid(bodies.position[i], i) : InsideSolid::No);
@@ -211,6 +227,8 @@ const ContainmentReport& ContainmentTracker::update() {
     for (uint32_t i = begin; i < end; ++i) {
       if (bodies.motion[i] != MotionType::Dynamic) continue;
       const Vec3d& p = bodies.position[i];
+      const Vec3d previous = lastWorld_[i];  // where the last update saw it (each body its own slot)
+      lastWorld_[i] = p;
       if (seenFrame_[i] == kWorldFrame && p == lastSeen_[i]) continue;
       const bool clear = state_[i] == InsideSolid::No;
       if (clear && !world_.nearSolidLastStep(i)) {
@@ -220,23 +238,29 @@ const ContainmentReport& ContainmentTracker::update() {
         continue;
       }
       // At rest (in the frame it was last seen in): checked again once it has moved further
-      // (from lastClear_ then). A body riding a moving grid must still have it alone near.
+      // (from lastClear_ then). A body riding a moving grid rests only while its way here
+      // since the last update reached no other solid (a static plate it was carried through);
+      // then it is clear of every other solid where it is now.
       if (clear && hasClear_[i]) {
         const uint32_t f = seenFrame_[i];
-        if (f == kWorldFrame ? (p - lastSeen_[i]).squaredNorm() < kRecheck2
-                             : (toFrame(f, p) - lastSeen_[i]).squaredNorm() < kRecheck2 && frameAt(p, i) == f)
+        if (f == kWorldFrame && (p - lastSeen_[i]).squaredNorm() < kRecheck2) continue;
+        if (f != kWorldFrame && (toFrame(f, p) - lastSeen_[i]).squaredNorm() < kRecheck2 &&
+            frameAt(WorldAabb{previous.cwiseMin(p), previous.cwiseMax(p)}, i) == f) {
+          lastClearWorld_[i] = p;
           continue;
+        }
       }
-      const uint32_t frame = frameAt(p, i);
+      const uint32_t frame = frameAt(WorldAabb{p, p}, i);
       checkFrame_[i] = frame;
       checkPlace_[i] = toFrame(frame, p);
-      const Vec3d from = fromFrame(clearFrame_[i], lastClear_[i]);
       // A centre inside a static grid's brick got there through the brick's surface, unless the
       // brick appeared around it (an edit): while static grids are unedited, the crossing test
-      // from the last clear place answers for them, and the point test looks at the rest.
+      // from the last clear place answers for them, and the point test looks at the rest. A
+      // last clear place kept in a moving grid's frame is tested against that grid there, and
+      // against the others from where it was last clear of them in the world.
       const bool viaCrossing = hasClear_[i] && !staticEdited;
       InsideSolid s = world_.pointInsideSolid(p, i, !viaCrossing);
-      if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsStaticGrid(from, p))
+      if (s == InsideSolid::No && hasClear_[i] && crossesGrid(i, p))
         s = viaCrossing && world_.pointInsideSolid(p, i) == InsideSolid::InBrick ? InsideSolid::InBrick : InsideSolid::WentThrough;
       checked_[i] = s == InsideSolid::InBrick   ? Check::InBrick
                     : s == InsideSolid::InVoxel ? Check::InVoxel
@@ -254,7 +278,7 @@ const ContainmentReport& ContainmentTracker::update() {
       case Check::None: break;
       case Check::FarFromSolid:
         // Clear before, and nowhere near a grid or terrain on its whole way here: clear now.
-        lastSeen_[i] = lastClear_[i] = p;
+        lastSeen_[i] = lastClear_[i] = lastClearWorld_[i] = p;
         seenFrame_[i] = clearFrame_[i] = kWorldFrame;
         hasClear_[i] = 1;
         break;
@@ -264,11 +288,11 @@ const ContainmentReport& ContainmentTracker::update() {
                         : checked_[i] == Check::InVoxel ? InsideSolid::InVoxel
                         : checked_[i] == Check::WentThrough ? InsideSolid::WentThrough
                                                               : InsideSolid::No;
-        if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsTerrain(fromFrame(clearFrame_[i], lastClear_[i]), p))
-          s = InsideSolid::WentThrough;
+        if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsTerrain(lastClearWorld_[i], p)) s = InsideSolid::WentThrough;
         if (s == InsideSolid::No) {
           lastClear_[i] = checkPlace_[i];
           clearFrame_[i] = checkFrame_[i];
+          lastClearWorld_[i] = p;
           hasClear_[i] = 1;
         }
         lastSeen_[i] = checkPlace_[i];

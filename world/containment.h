@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "collision/core/math_types.h"
+#include "world/broadphase.h"
 
 namespace bw {
 
@@ -71,7 +72,8 @@ class ContainmentTracker {
   enum class Check : uint8_t { None, FarFromSolid, InBrick, InVoxel, WentThrough, ClearOfGrids };
   // A body's places are kept in the world (kWorldFrame) or in a solid body's frame.
   static constexpr uint32_t kWorldFrame = ~0u;
-  uint32_t frameAt(const Vec3d& p, uint32_t self) const;  // where a body at p keeps its places
+  uint32_t frameAt(const WorldAabb& box, uint32_t self) const;  // where a body whose way is `box` keeps its places
+  bool crossesGrid(uint32_t body, const Vec3d& p) const;          // its way from its last clear place crosses a grid
   Vec3d toFrame(uint32_t frame, const Vec3d& p) const { return frame == kWorldFrame ? p : toSolidFrame(frame, p); }
   Vec3d fromFrame(uint32_t frame, const Vec3d& q) const { return frame == kWorldFrame ? q : fromSolidFrame(frame, q); }
   Vec3d toSolidFrame(uint32_t solid, const Vec3d& p) const;    // world -> the solid's frame, at its current pose
@@ -86,6 +88,8 @@ class ContainmentTracker {
   std::vector<Vec3d> lastSeen_;   // per body: centre when last checked (or found far from solid), in seenFrame_
   std::vector<Vec3d> lastClear_;  // per body: the last centre seen outside solid, in clearFrame_
   std::vector<uint32_t> seenFrame_, clearFrame_;
+  std::vector<Vec3d> lastWorld_;       // per body: centre at the last update, in the world
+  std::vector<Vec3d> lastClearWorld_;  // per body: the last centre known clear of every solid but its frame's, in the world
   std::vector<uint8_t> hasClear_; // per body: lastClear_ is set (not for a body that started inside)
   std::vector<InsideSolid> state_;
   ContainmentReport report_;

@@ -176,10 +176,10 @@ class World {
   /// staticGrids false leaves static grids out (the containment tracker tests them by the
   /// path instead while they are unedited).
   InsideSolid pointInsideSolid(const Vec3d& p, uint32_t self, bool staticGrids = true) const;
-  /// The one grid or terrain body (not `self`) whose last broadphase bounds hold point `p`
+  /// The one grid or terrain body (not `self`) whose last broadphase bounds reach into `box`
   /// (world), or kInvalidIndex when none or several do: the containment tracker keeps the
   /// places of a body riding a moving grid in that grid's frame.
-  uint32_t soleSolidNear(const Vec3d& p, uint32_t self) const;
+  uint32_t soleSolidReaching(const WorldAabb& box, uint32_t self) const;
   /// Sorts the solid bodies' reach (their last broadphase bounds) along x, so that the point
   /// and path queries above visit only the solids that can reach them (a fleet of 1,500 grid
   /// ships: every containment query looped over all of them). Between steps, on one thread;
@@ -195,7 +195,8 @@ class World {
   /// terrain. Fills terrain chunk caches as rays do, so not while step() runs.
   bool segmentHitsStatic(const Vec3d& from, const Vec3d& to);
   /// The same against static and kinematic grids only: reads only, safe on many threads.
-  bool segmentHitsStaticGrid(const Vec3d& from, const Vec3d& to) const;
+  /// `only` tests grid body `only` alone; `except` leaves grid body `except` out.
+  bool segmentHitsStaticGrid(const Vec3d& from, const Vec3d& to, uint32_t only = kInvalidIndex, uint32_t except = kInvalidIndex) const;
   /// The same against terrains only (fills their chunk caches: one thread, not during step()).
   bool segmentHitsTerrain(const Vec3d& from, const Vec3d& to);
   /// The world's job system, for work between steps that reads the world (containment).
