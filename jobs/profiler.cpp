@@ -121,6 +121,8 @@ class StageSums {
 
   WorkSpan workSpan() {
     std::sort(stages_.begin(), stages_.end(), [](const StageTime& a, const StageTime& b) { return a.stage < b.stage; });
+    index_.clear();  // the slots moved: a later add() finds them by the list again
+    last_ = 0;
     WorkSpan ws;
     ws.stageWorkMs.reserve(stages_.size());
     ws.stageSpanMs.reserve(stages_.size());
