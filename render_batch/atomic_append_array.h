@@ -71,6 +71,10 @@ class AtomicAppendArray {
     return std::string(what) + ": " + std::to_string(attempted()) + " appended, capacity " +
            std::to_string(capacity());
   }
+  /// Raises the capacity to at least n (allocates; only while no one appends or reads).
+  void growCapacity(uint32_t n) {
+    if (n > slots_.size()) slots_.resize(n);
+  }
   /// Empties the array (slots keep their memory); only while no one appends.
   void clear() noexcept { count_.value.store(0, std::memory_order_relaxed); }
 

@@ -20,6 +20,11 @@ void BatchedSubmitter::beginFrame(uint64_t frame) {
   current_->frame = frame;
 }
 
+void BatchedSubmitter::growCurrent(uint32_t primitiveCapacity, uint32_t lightCapacity) {
+  current_->primitives.growCapacity(primitiveCapacity);
+  current_->lights.growCapacity(lightCapacity);
+}
+
 void BatchedSubmitter::commitFrame(uint64_t frame) {
   TransformBatch& batch = *current_;
   if (batch.frame != frame)

@@ -34,6 +34,9 @@ class BatchedSubmitter final : public TransformUpdateSink {
 
   /// Prepares frame's batch (game thread, before the update); may wait for frame - 2.
   void beginFrame(uint64_t frame);
+  /// Raises the capacity of the batch begun to at least these counts (game thread, after
+  /// beginFrame: the render thread is done with that batch). Allocates only when it grows.
+  void growCurrent(uint32_t primitiveCapacity, uint32_t lightCapacity);
   /// Commits frame's batch as one command (game thread, after the update joined).
   void commitFrame(uint64_t frame);
 

@@ -4,7 +4,8 @@
 /// Per-object submission sends one command per moved primitive (PrimitiveUpdate), per moved
 /// light (LightUpdate), plus the radius refresh the engine of article 000 sent on every light
 /// move (LightRadiusUpdate); a FrameEnd closes the frame. Batched submission sends one
-/// BatchCommit per frame, which both applies the frame's batch and closes the frame.
+/// BatchCommit per frame, which both applies the frame's batch and closes the frame. In either
+/// mode a frame that added primitives starts with a GrowScene.
 #include <cstdint>
 #include <variant>
 
@@ -32,8 +33,15 @@ struct FrameEnd {
 /// Ends the render thread's loop (sent by the RenderThread destructor).
 struct StopRenderThread {};
 
+/// Grows the render scene to primitiveCount proxies before the frame's records that use them
+/// (sent by the game thread ahead of the frame's update, so it precedes them in the queue).
+struct GrowScene {
+  uint32_t primitiveCount;  ///< proxies the scene holds from now on
+};
+
 /// One render command (copied by value into the queue).
-using RenderCommand = std::variant<PrimitiveUpdate, LightUpdate, LightRadiusUpdate, BatchCommit, FrameEnd, StopRenderThread>;
+using RenderCommand =
+    std::variant<PrimitiveUpdate, LightUpdate, LightRadiusUpdate, BatchCommit, FrameEnd, GrowScene, StopRenderThread>;
 static_assert(sizeof(RenderCommand) == 192, "per-object submission copies one of these per moved object");
 
 }  // namespace bw

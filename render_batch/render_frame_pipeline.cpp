@@ -1,6 +1,9 @@
 #include "render_batch/render_frame_pipeline.h"
 
 #include <chrono>
+#include <string>
+
+#include "collision/core/argument_checks.h"
 
 #include "render_batch/concurrent_command_queue.h"
 #include "render_batch/mutex_command_queue.h"
@@ -26,7 +29,11 @@ double msSince(std::chrono::steady_clock::time_point t) {
 RenderFramePipeline::RenderFramePipeline(AttachmentStore& store, SubmissionMode mode,
                                          RenderThread::FenceObserver observer, uint32_t batchPrimitiveCapacity,
                                          uint32_t batchLightCapacity)
-    : store_(store), mode_(mode) {
+    : store_(store),
+      mode_(mode),
+      scenePrimitives_(store.primitiveCount()),
+      sceneLights_(store.lightCount()),
+      batchFollowsStore_{batchPrimitiveCapacity == UINT32_MAX, batchLightCapacity == UINT32_MAX} {
   render_ = std::make_unique<RenderThread>(RenderScene(store.primitiveCount(), store.lightAttenuationRadii()),
                                            makeQueue(mode, store), std::move(observer));
   if (mode == SubmissionMode::Batched)
@@ -48,6 +55,10 @@ FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, JobSystem&
 
 FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const UpdateRunner& runner) {
   FrameTiming timing;
+  if (store_.lightCount() != sceneLights_)
+    throw InvalidInput("RenderFramePipeline::runFrame: the store has " + std::to_string(store_.lightCount()) +
+                       " lights, the render scene registered " + std::to_string(sceneLights_) +
+                       " (lights cannot be added once the render thread runs)");
   const uint64_t frame = frame_ + 1;
   const auto waitStart = std::chrono::steady_clock::now();
   if (frame >= 3) render_->waitForFrame(frame - 2);
@@ -61,8 +72,15 @@ FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const Upda
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
     ~CommitTimer() { timing.commitMs = msSince(start); }
   };
+  // note: enqueued before the update starts, so it precedes every record of this frame in
+  // the queue (FIFO in happens-before order, which the workers' start gives).
+  if (store_.primitiveCount() > scenePrimitives_) {
+    scenePrimitives_ = store_.primitiveCount();
+    render_->enqueue(GrowScene{scenePrimitives_});
+  }
   if (batched_) {
     batched_->beginFrame(frame);
+    batched_->growCurrent(batchFollowsStore_[0] ? store_.primitiveCount() : 0, batchFollowsStore_[1] ? store_.lightCount() : 0);
     TransformUpdate update(store_, bodies, *batched_);
     runner(update);
     frame_ = frame;

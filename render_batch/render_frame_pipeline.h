@@ -7,6 +7,10 @@
 ///
 /// Frames in flight: frame N starts only after frame N-2's fence, so the render thread applies
 /// frame N-1 while the game computes frame N (DESIGN.md frame step 7) and never falls further behind.
+/// A store that gained primitives between frames (render chunks of placed bricks, parts split
+/// off) grows the render scene first (a GrowScene ahead of the frame's records) and, when the
+/// batch capacity follows the store (UINT32_MAX), the frame's batch. Lights are registered once:
+/// a store that gained lights is refused (InvalidInput), nothing submitted.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -34,7 +38,8 @@ class RenderFramePipeline {
   /// Runs a transform update (on the job system, on the caller's own threads, ...).
   using UpdateRunner = std::function<void(TransformUpdate&)>;
 
-  /// Render scene sized from store; batches sized from the store unless capacities are given.
+  /// Render scene sized from store; batches sized from the store (and growing with it) unless
+  /// capacities are given.
   RenderFramePipeline(AttachmentStore& store, SubmissionMode mode, RenderThread::FenceObserver observer = {},
                       uint32_t batchPrimitiveCapacity = UINT32_MAX, uint32_t batchLightCapacity = UINT32_MAX);
   ~RenderFramePipeline();
@@ -60,6 +65,9 @@ class RenderFramePipeline {
   std::unique_ptr<PerObjectSubmitter> perObject_;
   std::unique_ptr<BatchedSubmitter> batched_;
   uint64_t frame_ = 0;
+  uint32_t scenePrimitives_;     // proxies the render scene has (or will have, after its queue)
+  uint32_t sceneLights_;         // lights registered with the render scene
+  bool batchFollowsStore_[2];    // primitive, light capacity given as UINT32_MAX
 };
 
 }  // namespace bw

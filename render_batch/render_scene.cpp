@@ -36,6 +36,20 @@ RenderScene::RenderScene(uint32_t primitiveCount, std::vector<float> lightAttenu
   }
 }
 
+void RenderScene::growPrimitives(uint32_t n) {
+  if (n < primitiveCount())
+    throw InvalidInput("RenderScene::growPrimitives: " + std::to_string(n) + " proxies asked, the scene has " +
+                       std::to_string(primitiveCount()) + " (it never shrinks)");
+  boundsOrigin_.resize(n, Vec3d::Zero());
+  boundsExtent_.resize(n, Vec3f::Zero());
+  boundsRadius_.resize(n, 0.f);
+  localBounds_.resize(n, Aabb{Vec3f::Zero(), Vec3f::Zero()});
+  linear_.resize(n, Mat3f::Identity());
+  translation_.resize(n, Vec3d::Zero());
+  previousTranslation_.resize(n, Vec3d::Zero());
+  previousRotation_.resize(n, Quatf::Identity());
+}
+
 void RenderScene::applyPrimitive(const PrimitiveUpdate& u) {
   if (u.proxyId >= primitiveCount())
     throw InvalidInput("RenderScene::applyPrimitive: proxy " + std::to_string(u.proxyId) + " of " +

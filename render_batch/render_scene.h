@@ -29,6 +29,10 @@ class RenderScene {
   /// Recomputes a light's radius from its attenuation (idempotent: the radius is unchanged
   /// by motion, which is exactly why sending it per move is wasted work).
   void applyLightRadius(uint32_t lightId);
+  /// Adds proxies (at the origin, like the first ones) up to primitiveCount: the world adds
+  /// render chunks when bricks are placed in new cells or a grid splits into bodies. Never
+  /// shrinks (a proxy no longer needed is hidden and reused); InvalidInput if asked to.
+  void growPrimitives(uint32_t primitiveCount);
 
   /// Number of primitive proxies.
   uint32_t primitiveCount() const { return static_cast<uint32_t>(boundsOrigin_.size()); }
@@ -50,6 +54,8 @@ class RenderScene {
   float boundsRadius(uint32_t id) const { return boundsRadius_[id]; }
   /// Local bounds of a proxy.
   const Aabb& localBounds(uint32_t id) const { return localBounds_[id]; }
+  /// False for a hidden proxy (empty local bounds: a render chunk whose bricks are all gone).
+  bool visible(uint32_t id) const { return !localBounds_[id].isEmpty(); }
   /// Rotation part of a proxy's local-to-world matrix.
   const Mat3f& localToWorldLinear(uint32_t id) const { return linear_[id]; }
   /// Translation of a proxy's local-to-world matrix.

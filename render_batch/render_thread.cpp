@@ -88,6 +88,8 @@ bool RenderThread::execute(const RenderCommand& command) {
           publishFence(c.frame);
         } else if constexpr (std::is_same_v<C, FrameEnd>) {
           publishFence(c.frame);
+        } else if constexpr (std::is_same_v<C, GrowScene>) {
+          scene_.growPrimitives(c.primitiveCount);
         } else {
           return false;
         }

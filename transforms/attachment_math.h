@@ -26,8 +26,11 @@ inline WorldMatrix makeWorldMatrix(const Vec3d& translation, const Quatf& rotati
   return m;
 }
 
-/// World bounds of a local box under a local-to-world matrix (box of the rotated box).
+/// World bounds of a local box under a local-to-world matrix (box of the rotated box). An empty
+/// local box (a hidden primitive: a render chunk whose bricks were all removed) gives a point
+/// at the local origin with zero extent and radius, never the infinities of its corners.
 inline WorldBounds makeWorldBounds(const Aabb& local, const WorldMatrix& m) {
+  if (local.isEmpty()) return WorldBounds{m.translation, Vec3f::Zero(), 0.f};
   const Vec3f c = local.center();
   const Vec3f h = local.halfExtent();
   WorldBounds b;

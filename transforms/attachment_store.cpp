@@ -24,6 +24,7 @@ uint32_t AttachmentStore::add(uint32_t body, uint32_t parent, const Vec3f& t, co
     if (depth_[parent] + 1u >= kMaxAttachmentDepth)
       throw InvalidInput(std::string(context) + ": hierarchy deeper than " + std::to_string(kMaxAttachmentDepth));
     depth = static_cast<uint8_t>(depth_[parent] + 1);
+    hasChildren_[parent] = 1;
   }
   const uint32_t id = size();
   body_.push_back(body);
@@ -40,6 +41,7 @@ uint32_t AttachmentStore::add(uint32_t body, uint32_t parent, const Vec3f& t, co
   renderId_.push_back(renderId);
   depth_.push_back(depth);
   localBounds_.push_back(bounds);
+  hasChildren_.push_back(0);
   bodiesReferenced_ = std::max(bodiesReferenced_, body + 1);
   orderDirty_ = true;
   return id;
@@ -93,6 +95,48 @@ void AttachmentStore::reserve(uint32_t n) {
   renderId_.reserve(n);
   depth_.reserve(n);
   localBounds_.reserve(n);
+  hasChildren_.reserve(n);
+}
+
+namespace {
+
+void requireFiniteOrEmpty(const Aabb& b, const char* context) {
+  if (b.isEmpty()) {
+    if (b.min.hasNaN() || b.max.hasNaN()) throw InvalidInput(std::string(context) + ": localBounds has NaN");
+    return;
+  }
+  requireFinite(b.min, context, "localBounds.min");
+  requireFinite(b.max, context, "localBounds.max");
+}
+
+}  // namespace
+
+void AttachmentStore::setPrimitiveBounds(uint32_t id, const Aabb& localBounds) {
+  const char* context = "AttachmentStore::setPrimitiveBounds";
+  if (id >= size()) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " does not exist");
+  if (kind_[id] != AttachmentKind::Primitive) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " is a light");
+  requireFiniteOrEmpty(localBounds, context);
+  localBounds_[id] = localBounds.isEmpty() ? Aabb::empty() : localBounds;
+  localDirty_[id] = 1;
+}
+
+void AttachmentStore::rebindPrimitive(uint32_t id, uint32_t body, const Vec3f& localTranslation, const Quatf& localRotation,
+                                      const Aabb& localBounds) {
+  const char* context = "AttachmentStore::rebindPrimitive";
+  if (id >= size()) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " does not exist");
+  if (kind_[id] != AttachmentKind::Primitive) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " is a light");
+  if (parent_[id] != kInvalidIndex || hasChildren_[id])
+    throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " is part of a hierarchy");
+  if (body == UINT32_MAX) throw InvalidInput(std::string(context) + ": body index is UINT32_MAX");
+  requireFinite(localTranslation, context, "localTranslation");
+  requireUnitQuaternion(localRotation, context, "localRotation");
+  requireFiniteOrEmpty(localBounds, context);
+  body_[id] = body;
+  localTranslation_[id] = localTranslation;
+  localRotation_[id] = localRotation.normalized();
+  localBounds_[id] = localBounds.isEmpty() ? Aabb::empty() : localBounds;
+  localDirty_[id] = 1;
+  bodiesReferenced_ = std::max(bodiesReferenced_, body + 1);
 }
 
 void AttachmentStore::prepareUpdateOrder() {

@@ -14,7 +14,11 @@
 /// child reads it, without locks. The level order is rebuilt only when attachments are added.
 /// Render ids: primitives get proxy ids 0..primitiveCount-1 and lights light ids
 /// 0..lightCount-1 in creation order; those are the render scene's indices.
-/// Thread safety: edits (add*, setLocalOffset) only while no update runs.
+/// Hidden primitives: a primitive whose local bounds are empty (Aabb::empty()) is sent with zero
+/// extent and the render scene reports it invisible. The world hides the render chunk of a cell
+/// whose bricks are all gone and later rebinds it to whatever needs a new chunk, so a store
+/// grows only to the most chunks ever visible at once.
+/// Thread safety: edits (add*, set*, rebind*) only while no update runs.
 #include <cstdint>
 #include <vector>
 
@@ -58,6 +62,14 @@ class AttachmentStore {
                     float attenuationRadius);
   /// Changes a local offset; the attachment and its subtree are recomputed on the next update.
   void setLocalOffset(uint32_t id, const Vec3f& localTranslation, const Quatf& localRotation);
+  /// Changes a primitive's local bounds (empty = hidden); resent on the next update. Throws
+  /// InvalidInput for a light, an unknown id or NaN bounds.
+  void setPrimitiveBounds(uint32_t id, const Aabb& localBounds);
+  /// Moves a primitive that rides directly on its body and carries no children to another body
+  /// with a new offset and bounds (empty = hidden); resent on the next update. Throws
+  /// InvalidInput otherwise.
+  void rebindPrimitive(uint32_t id, uint32_t body, const Vec3f& localTranslation, const Quatf& localRotation,
+                       const Aabb& localBounds);
   /// Recomputes and resends every attachment on the next update (after a frame the render side
   /// never applied, e.g. a batch overflow, so the render scene catches up in one frame).
   void markAllDirty();
@@ -126,6 +138,7 @@ class AttachmentStore {
   std::vector<uint32_t> renderId_;
   std::vector<uint8_t> depth_;
   std::vector<Aabb> localBounds_;
+  std::vector<uint8_t> hasChildren_;        // 1 once another attachment rides on it
   std::vector<float> lightAttenuation_;     // by light id
 
   uint32_t levelBegin_[kMaxAttachmentDepth + 1] = {};

@@ -139,8 +139,6 @@ void validateScene(const SceneDescription& scene) {
                                  t.size.y > kMaxGeneratedTerrain || t.size.z > kMaxGeneratedTerrain))
       c.message(f + ".size", "expected at least 32 x 32 x 16 and at most " + std::to_string(kMaxGeneratedTerrain) + " voxels a side");
     if (t.anchorBelow < 0) c.message(f + ".anchor_below", "expected a height of 0 or more (model voxels)");
-    if (t.breakFree && scene.attachments.enabled)
-      c.message(f + ".break_free", "not with attachments yet: regions broken free would have no render proxies");
   }
   for (size_t i = 0; i < scene.grids.size(); ++i) {
     const GridDescription& g = scene.grids[i];
@@ -149,8 +147,6 @@ void validateScene(const SceneDescription& scene) {
     // note: a template's bricks are shared by every copy; which copy a removal splits is not defined.
     for (const SpawnerDescription& sp : scene.spawners)
       if (sp.shape == SpawnerDescription::Shape::Grid && sp.grid == g.name) c.message(f, "a grid that spawners copy cannot split");
-    if (scene.attachments.enabled)
-      c.message(f, "not with attachments yet: parts split off would have no render proxies (remove \"attachments\" or \"split\")");
   }
   c.number("rays.length", scene.rays.length, 0, kMaxRayLength);
   for (size_t i = 0; i < scene.edits.size(); ++i) {

@@ -96,6 +96,7 @@ BrickGrid& World::editGrid(uint32_t index) {
                        " grids");
   editedGrids_.push_back(index);
   wholeGridEdits_.push_back(index);  // where it is edited is not known: everything on it wakes
+  if (renderChunks_) renderChunks_->gridChanged(index);
   if (links_[index]) linksStale_[index] = 1;
   if (recordingEdits_) betweenSteps_.wholeGrids.push_back(index);
   return *grids_[index];
@@ -118,6 +119,7 @@ World::RemovalResult World::removeBricks(uint32_t index, std::span<const uint32_
     if (!grid.hasBrick(id)) continue;
     if (recordingEdits_) editLog_.bricks.push_back({index, id, false, grid.brick(id)});
     if (links_[index]) links_[index]->removing(id, splitSeeds_[index]);
+    if (renderChunks_) renderChunks_->removing(index, grid.brick(id));
     grid.removeBrick(id);
   }
   editedGrids_.push_back(index);
@@ -320,10 +322,11 @@ void World::refreshStaleLinks() {
 
 EditLoad::Hooks World::editHooks() {
   const bool linked = std::any_of(links_.begin(), links_.end(), [](const auto& l) { return l != nullptr; });
-  if (!linked && !recordingEdits_) return {};
+  if (!linked && !recordingEdits_ && !renderChunks_) return {};
   EditLoad::Hooks hooks;
   hooks.beforeRemove = [this](uint32_t grid, uint32_t brick) {
     if (recordingEdits_) editLog_.bricks.push_back({grid, brick, false, grids_[grid]->brick(brick)});
+    if (renderChunks_) renderChunks_->removing(grid, grids_[grid]->brick(brick));
     if (!links_[grid]) return;
     const auto t = Clock::now();
     links_[grid]->removing(brick, splitSeeds_[grid]);
@@ -331,6 +334,7 @@ EditLoad::Hooks World::editHooks() {
   };
   hooks.afterPlace = [this](uint32_t grid, uint32_t brick) {
     if (recordingEdits_) editLog_.bricks.push_back({grid, brick, true, grids_[grid]->brick(brick)});
+    if (renderChunks_) renderChunks_->placed(grid, grids_[grid]->brick(brick));
     if (!links_[grid]) return;
     const auto t = Clock::now();
     links_[grid]->placed(*grids_[grid], brick);
@@ -372,6 +376,7 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   if (part.size() < debrisBricks_[g]) {
     for (uint32_t id : part) {
       if (recordingEdits_) editLog_.bricks.push_back({g, id, false, old.brick(id)});
+      if (renderChunks_) renderChunks_->removing(g, old.brick(id));
       links_[g]->removing(id, ignored);
       old.removeBrick(id);
     }
@@ -383,6 +388,8 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(part.size() + 1024)));
   if (recordingEdits_)
     for (uint32_t id : part) editLog_.bricks.push_back({g, id, false, old.brick(id)});
+  if (renderChunks_)
+    for (uint32_t id : part) renderChunks_->removing(g, old.brick(id));
   const std::vector<uint32_t> ids = old.moveBricks(part, *grid);
   auto partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   // Its centre of mass moves as that point of the old body did (v + w x r about the old body's
@@ -531,7 +538,14 @@ void World::step() {
   if (render_) {
     // Frame steps 5-7 (world_render.h); the stage ids follow the ray load's.
     ProfileZone z(profiler_, "render (stage)");
+    const auto chunks = Clock::now();
+    {
+      ProfileZone c(profiler_, "render chunks", renderStage(), true);
+      refreshAttachments();
+    }
+    stats_.renderChunksMs = msSince(chunks);
     stats_.render = render_->run(bodies_, sleep_, jobs_, profiler_, renderStage());
+    stats_.render.updateMs += stats_.renderChunksMs;
   }
   profiler_.endFrame();
   stats_.totalMs = msSince(t);

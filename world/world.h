@@ -52,6 +52,7 @@
 #include "world/terrain_carve_load.h"
 #include "world/terrain_pair_work.h"
 #include "collision/terrain/voxel_regions.h"
+#include "world/render_chunks.h"
 #include "world/world_render.h"
 
 namespace bw {
@@ -72,6 +73,8 @@ struct StepStats {
   uint32_t largestIsland = 0;    ///< contacts in the largest island (last substep)
   uint32_t splitIslands = 0;     ///< islands solved colour by colour on every thread
   RenderStageStats render;       ///< frame steps 5-7 (zero without attachments)
+  RenderChunkStats renderChunks; ///< render chunks brought up to date with the frame's edits and parts
+  double renderChunksMs = 0;     ///< that upkeep (counted in the render update's stage)
   double editMs = 0;             ///< the frame's edits: bricks placed and removed (index, mass), then wakes, body mass, pair caches
   double editLoadMs = 0;         ///< the scene's edit load choosing what to edit (random picks, free-spot checks)
   uint32_t bricksRemoved = 0, bricksPlaced = 0;  ///< by the scene's edit load this frame
@@ -246,8 +249,11 @@ class World {
   void buildGrid(const GridDescription& g);
   void buildTerrain(const TerrainDescription& t);
   void spawn(const SpawnerDescription& s);
-  // Render attachments of every body (render_attachments.cpp).
-  AttachmentStore buildAttachments() const;
+  // Render attachments of every body (render_attachments.cpp): built once, then kept in step
+  // with edits, splits and new bodies before every render frame.
+  AttachmentStore buildAttachments();
+  void addBodyAttachments(uint32_t body, AttachmentStore& store);
+  void refreshAttachments();
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
   // Bodies that start inside solid (depenetration.cpp).
@@ -412,6 +418,10 @@ class World {
   StepStats stats_;
   uint32_t frame_ = 0;
   int stage_ = 0;  // first profiling stage id of the running substep
+  // Render chunks of grid bodies (scenes with attachments), and how many bodies have their
+  // attachments (later ones get theirs before the next render frame).
+  std::unique_ptr<RenderChunks> renderChunks_;
+  uint32_t renderedBodies_ = 0;
   // Last member: the render thread stops before anything it was fed from goes away.
   std::unique_ptr<WorldRender> render_;
 };

@@ -18,7 +18,8 @@ constexpr uint32_t kMinPoseGrain = 256;
 // Fewest attachments per job of the transform update (an attachment is tens of nanoseconds).
 constexpr uint32_t kMinUpdateGrain = 128;
 
-uint32_t batchSize(uint32_t asked, uint32_t all) { return asked == 0 ? all : asked; }
+// The pipeline's "follow the store" capacity for 0.
+uint32_t batchSize(uint32_t asked) { return asked == 0 ? UINT32_MAX : asked; }
 
 }  // namespace
 
@@ -45,10 +46,15 @@ WorldRender::WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bo
     lastBusy = stats.busyNanoseconds;
   };
   pipeline_ = std::make_unique<RenderFramePipeline>(store_, mode, std::move(observer),
-                                                    batchSize(batchPrimitives, store_.primitiveCount()),
-                                                    batchSize(batchLights, store_.lightCount()));
-  // One timing slot per update chunk of every level, laid out once (the store no longer changes).
+                                                    batchSize(batchPrimitives), batchSize(batchLights));
+  layOutUpdateChunks();
+}
+
+void WorldRender::layOutUpdateChunks() {
   store_.prepareUpdateOrder();
+  laidOutFor_ = store_.size();
+  levelFirstChunk_.clear();
+  levelGrain_.clear();
   uint32_t chunks = 0;
   for (uint32_t level = 0; level < store_.levelCount(); ++level) {
     const uint32_t begin = store_.levelBegin(level), end = store_.levelBegin(level + 1);
@@ -57,6 +63,19 @@ WorldRender::WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bo
     chunks += JobSystem::chunkCount(begin, end, levelGrain_.back());
   }
   chunkTimes_.resize(chunks);
+}
+
+void WorldRender::growBodies(const BodyStore& bodies) {
+  const uint32_t n = bodies.size();
+  for (uint32_t i = uint32_t(position_.size()); i < n; ++i) {
+    const RigidTransform pose = bodies.shapePose(i);
+    position_.push_back(pose.translation);
+    rotation_.push_back(pose.rotation);
+  }
+  moved_.resize(n, 0);
+  asleepBefore_.resize(n, 0);
+  poseGrain_ = tuning::grainFor(n, kMinPoseGrain);
+  movedPerChunk_.assign(JobSystem::chunkCount(0, n, poseGrain_), 0);
 }
 
 uint32_t WorldRender::markMovedBodies(const BodyStore& bodies, const SleepState& sleep, JobSystem& jobs, Profiler& profiler,
@@ -94,9 +113,11 @@ uint32_t WorldRender::markMovedBodies(const BodyStore& bodies, const SleepState&
 }
 
 RenderStageStats WorldRender::run(const BodyStore& bodies, const SleepState& sleep, JobSystem& jobs, Profiler& profiler, int stage) {
-  if (bodies.size() != position_.size())
-    throw InvalidInput("WorldRender::run: the world has " + std::to_string(bodies.size()) + " bodies, the render was built for " +
-                       std::to_string(position_.size()));
+  if (bodies.size() < position_.size())
+    throw InvalidInput("WorldRender::run: the world has " + std::to_string(bodies.size()) + " bodies, the render has seen " +
+                       std::to_string(position_.size()) + " (bodies are never removed)");
+  if (bodies.size() > position_.size()) growBodies(bodies);
+  if (store_.size() != laidOutFor_) layOutUpdateChunks();
   RenderStageStats stats;
   const auto poseStart = Clock::now();
   stats.movedBodies = markMovedBodies(bodies, sleep, jobs, profiler, stage);

@@ -20,6 +20,10 @@
 /// l the update at stage + 1 + 2l and the submission at stage + 2 + 2l (serial zones with the
 /// mutex queue: its pushes hold one lock, so work/span counts them all in the span), the commit
 /// at stage + 1 + 2 * kMaxAttachmentDepth.
+/// Growth: the world edits the store between runs (render chunks of edited cells resized, hidden,
+/// added or rebound; parts split off given theirs), and bodies may be added (parts, slabs): the
+/// next run looks at the new bodies from their current poses, lays its update chunks out again
+/// and grows the render scene ahead of the frame's records (render_frame_pipeline.h).
 /// Overflow of a batch (deliberately small capacities): run() throws CapacityExceeded naming
 /// the batch and its capacity; the render scene keeps the previous frame, and every attachment
 /// is resent on the next frame so the render scene catches up at once.
@@ -80,7 +84,7 @@ struct RenderStageStats {
 class WorldRender {
  public:
   /// Render scene sized from store; a batch holds batchPrimitives / batchLights records a frame
-  /// (0 = every primitive / light). bodyCount bodies are looked at.
+  /// (0 = every primitive / light, growing with the store). bodyCount bodies are looked at at first.
   /// The render thread records its busy time per frame into profiler (zone "render thread:
   /// apply", stage -1: beside the frames, outside their work/span); read it after finish().
   WorldRender(AttachmentStore store, SubmissionMode mode, uint32_t bodyCount, uint32_t batchPrimitives, uint32_t batchLights,
@@ -98,6 +102,8 @@ class WorldRender {
   RenderThreadStats renderStats() const { return pipeline_->renderThread().stats(); }
   /// The attachments.
   const AttachmentStore& store() const { return store_; }
+  /// The attachments, to edit between runs (never while run() is running).
+  AttachmentStore& attachments() { return store_; }
   /// Submission mode.
   SubmissionMode mode() const { return pipeline_->mode(); }
   /// Frames submitted.
@@ -105,6 +111,10 @@ class WorldRender {
 
  private:
   uint32_t markMovedBodies(const BodyStore& bodies, const SleepState& sleep, JobSystem& jobs, Profiler& profiler, int stage);
+  // Takes in bodies added since the last run (their current poses, not moved).
+  void growBodies(const BodyStore& bodies);
+  // One timing slot per update chunk of every level, for the store as it is now.
+  void layOutUpdateChunks();
 
   AttachmentStore store_;
   std::unique_ptr<RenderFramePipeline> pipeline_;
@@ -118,6 +128,7 @@ class WorldRender {
   std::vector<UpdateRangeTimes> chunkTimes_;  // transform update: per chunk of every level
   std::vector<uint32_t> levelFirstChunk_;     // index of each level's first chunk in chunkTimes_
   std::vector<uint32_t> levelGrain_;          // attachments per job of each level
+  uint32_t laidOutFor_ = UINT32_MAX;          // store size the chunk layout was made for
   bool checkAll_ = true;
   uint64_t reportedBusyNs_ = 0;
 };

@@ -4,7 +4,13 @@
 
 namespace bw::cli {
 
-void RenderFigures::add(const RenderStageStats& r) {
+void RenderFigures::add(const StepStats& s) {
+  const RenderStageStats& r = s.render;
+  chunkUpkeep.v.push_back(s.renderChunksMs);
+  cellsRefreshed += s.renderChunks.cellsRefreshed;
+  cellsRecomputed += s.renderChunks.cellsRecomputed;
+  chunksAdded += s.renderChunks.chunksAdded;
+  chunksHidden += s.renderChunks.chunksHidden;
   update.v.push_back(r.updateMs);
   submission.v.push_back(r.submissionMs);
   commit.v.push_back(r.commitMs);
@@ -47,6 +53,11 @@ nlohmann::json RenderFigures::json(const World& world) const {
                    {"render_thread_busy_ms_per_frame", renderBusyMs / frames},
                    {"render_scene_hash", sceneHash}};
   for (int p : {1, 2, 4, 8, 16}) j["predicted_submission_commit_ms"][std::to_string(p)] = predictedMs(p);
+  j["chunks"] = {{"upkeep", chunkUpkeep.json()},
+                 {"cells_refreshed_per_frame", double(cellsRefreshed) / frames},
+                 {"cells_recomputed", cellsRecomputed},
+                 {"chunks_added", chunksAdded},
+                 {"chunks_hidden", chunksHidden}};
   return j;
 }
 
@@ -58,6 +69,11 @@ void RenderFigures::print(const World& world) const {
   for (auto [name, s] : {std::pair<const char*, const Series*>{"transform", &update}, {"submission", &submission}, {"commit", &commit},
                          {"render wait", &wait}})
     std::printf("  %-11s %7.3f ms %7.3f ms %7.3f ms\n", name, s->quantile(0.5), s->quantile(0.95), s->max());
+  if (cellsRefreshed || chunksAdded)
+    std::printf("  render chunks: %.0f cells a frame followed edits and parts (%llu rebuilt from the grid), %llu chunks added, %llu "
+                "hidden; upkeep %.3f ms median, %.3f ms max a frame (in transform)\n",
+                double(cellsRefreshed) / frames, (unsigned long long)cellsRecomputed, (unsigned long long)chunksAdded,
+                (unsigned long long)chunksHidden, chunkUpkeep.quantile(0.5), chunkUpkeep.max());
   std::printf("  render thread busy %.3f ms per frame; render scene hash %016llx\n", renderBusyMs / frames,
               (unsigned long long)sceneHash);
   std::printf("  submission + commit predicted at 1/2/4/8/16 threads: %.3f %.3f %.3f %.3f %.3f ms per frame\n", predictedMs(1),
@@ -96,7 +112,7 @@ bool compareSubmissionModes(const SceneDescription& scene, int threads, uint32_t
     RenderFigures f;
     for (uint32_t k = 0; k < frames; ++k) {
       world.step();
-      f.add(world.lastStats().render);
+      f.add(world.lastStats());
     }
     f.finish(world);
     row(submissionModeName(mode), f);

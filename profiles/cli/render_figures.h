@@ -16,12 +16,14 @@ namespace bw::cli {
 /// Render figures of one run (one submission mode).
 struct RenderFigures {
   Series update, submission, commit, wait, gameThread;  ///< ms per frame; gameThread = update + submission + commit
+  Series chunkUpkeep;  ///< of update: render chunks brought up to date with edits and parts (ms per frame)
+  uint64_t cellsRefreshed = 0, cellsRecomputed = 0, chunksAdded = 0, chunksHidden = 0;  ///< summed over frames
   double renderBusyMs = 0;                             ///< render thread, whole run
   uint64_t primitives = 0, lights = 0, movedBodies = 0;  ///< summed over frames
   uint32_t frames = 0;
 
-  /// Adds one frame.
-  void add(const RenderStageStats& r);
+  /// Adds one frame (its render stage and render-chunk upkeep).
+  void add(const StepStats& s);
   /// Waits for the render thread and takes the busy time and the scene hash (call after the run).
   void finish(World& world);
   uint64_t sceneHash = 0;  ///< render scene hash after the run (set by finish)

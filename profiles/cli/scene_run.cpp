@@ -313,7 +313,7 @@ int runScene(const SceneRunOptions& o) {
     debrisVoxels += s.debrisVoxels;
     voxelsSearched += s.voxelsSearched;
     if (s.voxelsCarved) terrainEditTimes.v.push_back(s.terrainEditMs);
-    if (world.render()) render.add(s.render);
+    if (world.render()) render.add(s);
     rayCount += s.rays;
     rayHits += s.rayHits;
     rayBoxTests += s.rayBoxTests;

@@ -45,7 +45,7 @@ SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames, Subm
   for (uint32_t f = 0; f < frames; ++f) {
     world.step();
     t.push_back(world.lastStats().totalMs);
-    if (world.render()) render.add(world.lastStats().render);
+    if (world.render()) render.add(world.lastStats());
   }
   SweepRow r{threads, 0, 0, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), world.stateHash(), 0, 0, {}, {}, false};
   std::sort(t.begin(), t.end());

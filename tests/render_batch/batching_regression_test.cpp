@@ -236,6 +236,77 @@ TEST(BatchOverflow, ExactCapacityIsEnough) {
   EXPECT_TRUE(pipeline.renderThread().scene().identicalTo(refScene));
 }
 
+// A store edited between frames the way the world edits it for brick edits and splits:
+// primitives added (the render scene and a batch that follows the store grow before the frame's
+// records), hidden (empty bounds), rebound to other bodies. Every mode ends byte-identical to a
+// serial reference that grows its scene by hand; nothing is lost across the growth.
+TEST(StoreGrowth, AddedHiddenAndReboundPrimitivesReachTheRenderSceneInEveryMode) {
+  for (SubmissionMode mode : {SubmissionMode::Batched, SubmissionMode::PerObjectMutex, SubmissionMode::PerObjectConcurrent}) {
+    AttachmentWorkload w = makeAttachmentWorkload({.attachments = 3000, .seed = 77, .maxDepth = 3});
+    AttachmentWorkload ref = makeAttachmentWorkload({.attachments = 3000, .seed = 77, .maxDepth = 3});
+    RenderScene refScene(ref.store.primitiveCount(), ref.store.lightAttenuationRadii());
+    RenderFramePipeline pipeline(w.store, mode);
+    std::mt19937 rng(5);
+    const uint32_t bodies = w.store.bodiesReferenced();
+    for (uint64_t frame = 1; frame <= 12; ++frame) {
+      if (frame % 3 == 0) {
+        // The same edits on both stores: 150 new primitives on random bodies, 40 hidden, 40
+        // hidden ones rebound elsewhere.
+        const uint32_t first = w.store.size();
+        for (int k = 0; k < 150; ++k) {
+          const uint32_t body = rng() % bodies;
+          const Aabb box{Vec3f(-1, -2, -0.5f), Vec3f(1, 2, float(k % 7))};
+          w.store.addPrimitive(body, kInvalidIndex, Vec3f(float(k), 0, 1), Quatf::Identity(), box);
+          ref.store.addPrimitive(body, kInvalidIndex, Vec3f(float(k), 0, 1), Quatf::Identity(), box);
+        }
+        for (int k = 0; k < 40; ++k) {
+          const uint32_t id = first + k;
+          w.store.setPrimitiveBounds(id, Aabb::empty());
+          ref.store.setPrimitiveBounds(id, Aabb::empty());
+        }
+        for (int k = 0; k < 40; k += 2) {
+          const uint32_t id = first + k, body = rng() % bodies;
+          w.store.rebindPrimitive(id, body, Vec3f(3, 2, 1), Quatf::Identity(), Aabb{-Vec3f::Ones(), Vec3f::Ones()});
+          ref.store.rebindPrimitive(id, body, Vec3f(3, 2, 1), Quatf::Identity(), Aabb{-Vec3f::Ones(), Vec3f::Ones()});
+        }
+        refScene.growPrimitives(ref.store.primitiveCount());
+      }
+      w.bodies.step(frame, kMovingFraction);
+      ref.bodies.step(frame, kMovingFraction);
+      DirectApply sink(refScene);
+      TransformUpdate(ref.store, ref.bodies.view(), sink).runSerial();
+      ASSERT_NO_THROW(pipeline.runFrame(w.bodies.view(), [](TransformUpdate& u) { test::runOnThreadTeam(u, 2); }))
+          << submissionModeName(mode);
+    }
+    pipeline.finish();
+    const RenderScene& scene = pipeline.renderThread().scene();
+    ASSERT_EQ(scene.primitiveCount(), w.store.primitiveCount()) << submissionModeName(mode);
+    EXPECT_TRUE(scene.identicalTo(refScene)) << submissionModeName(mode);
+    uint32_t hidden = 0;
+    for (uint32_t id = 0; id < scene.primitiveCount(); ++id) hidden += !scene.visible(id);
+    EXPECT_EQ(hidden, 80u) << submissionModeName(mode) << ": 4 rounds each hid 40 and gave 20 of them back";
+  }
+}
+
+TEST(StoreGrowth, LightsAddedOnceTheRenderThreadRunsAreRefusedAndScenesNeverShrink) {
+  AttachmentWorkload w = makeAttachmentWorkload({.attachments = 200, .seed = 3});
+  RenderFramePipeline pipeline(w.store, SubmissionMode::Batched);
+  pipeline.runFrame(w.bodies.view(), [](TransformUpdate& u) { u.runSerial(); });
+  w.store.addLight(0, kInvalidIndex, Vec3f::Zero(), Quatf::Identity(), 4.f);
+  try {
+    pipeline.runFrame(w.bodies.view(), [](TransformUpdate& u) { u.runSerial(); });
+    ADD_FAILURE() << "a light added after the start was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("lights cannot be added"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(pipeline.frame(), 1u) << "nothing was submitted";
+  RenderScene scene(10, {});
+  EXPECT_THROW(scene.growPrimitives(9), InvalidInput);
+  scene.growPrimitives(12);
+  EXPECT_EQ(scene.primitiveCount(), 12u);
+  EXPECT_TRUE(scene.visible(11));
+}
+
 TEST(RenderThread, ErrorOnTheRenderThreadReachesTheGame) {
   RenderThread render(RenderScene(2, {}), std::make_unique<MutexCommandQueue>());
   render.enqueue(makePrimitiveUpdate(7, Aabb::fromCenterHalf(Vec3f::Zero(), Vec3f::Ones()), Vec3d::Zero(),

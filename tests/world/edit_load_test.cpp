@@ -423,9 +423,6 @@ TEST(EditLoadSplit, SplitGridsAreRefusedWhereASplitIsUndefined) {
   refused(R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0, 0], "half_size": [1, 1, 1]}], "split": true}],
               "spawners": [{"shape": "grid", "grid": "g", "count": 2, "region": {"min": [0, 0, 5], "max": [9, 9, 9]}}]})",
           "grids[0].split: a grid that spawners copy cannot split");
-  refused(R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0, 0], "half_size": [1, 1, 1]}], "split": true}],
-              "attachments": {}})",
-          "grids[0].split: not with attachments yet");
   EXPECT_THROW(parseScene(R"({"name": "x", "grids": [{"name": "g", "bricks": [{"position": [0, 0, 0], "half_size": [1, 1, 1]}], "debris_bricks": 3}]})",
                            "x.json"),
                SceneError);

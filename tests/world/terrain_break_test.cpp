@@ -78,7 +78,6 @@ TEST(TerrainBreak, BadTerrainEditsAreRefusedNamingTheField) {
       {R"({"name": "x", "terrains": [{"name": "q", "generator": "quarry", "file": "a.vox"}]})", "exactly one of"},
       {R"({"name": "x", "terrains": [)" + terrain + R"(], "edits": [{"terrain": "q", "kind": "carve", "region": {"min": [5, 0, 0], "max": [1, 1, 1]}}]})",
        "min.x is greater than max.x"},
-      {R"({"name": "x", "terrains": [{"name": "q", "generator": "quarry", "break_free": true}], "attachments": {}})", "break_free"},
   };
   for (const auto& [text, field] : cases) {
     try {
