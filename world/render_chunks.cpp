@@ -111,10 +111,18 @@ uint32_t RenderChunks::slot(GridCells& g, const CellKey& key) {
   return s;
 }
 
-void RenderChunks::touch(GridCells& g, uint32_t s) {
+void RenderChunks::markDirty(uint32_t grid) {
+  if (grids_[grid].dirty) return;
+  grids_[grid].dirty = true;
+  dirtyGrids_.push_back(grid);
+}
+
+void RenderChunks::touch(uint32_t grid, uint32_t s) {
+  GridCells& g = grids_[grid];
   if (g.cells[s].touched) return;
   g.cells[s].touched = true;
   g.touched.push_back(s);
+  markDirty(grid);
 }
 
 void RenderChunks::placed(uint32_t grid, const Brick& brick) {
@@ -127,7 +135,7 @@ void RenderChunks::placed(uint32_t grid, const Brick& brick) {
     ++cell.bricks;  // rebuilt at the refresh anyway
   else
     mergeBrick(cell, box);
-  touch(g, s);
+  touch(grid, s);
 }
 
 void RenderChunks::removing(uint32_t grid, const Brick& brick) {
@@ -137,10 +145,11 @@ void RenderChunks::removing(uint32_t grid, const Brick& brick) {
   const uint32_t s = g.slotOf.find(keyOf(box));
   if (s == kInvalidIndex || g.cells[s].bricks == 0) {
     g.whole = true;  // a brick never reported placed: take the grid again
+    markDirty(grid);
     return;
   }
   Cell& cell = g.cells[s];
-  touch(g, s);
+  touch(grid, s);
   if (--cell.bricks == 0) {
     cell.box = Aabb::empty();
     std::fill(std::begin(cell.onFace), std::end(cell.onFace), 0u);
@@ -156,7 +165,9 @@ void RenderChunks::removing(uint32_t grid, const Brick& brick) {
 }
 
 void RenderChunks::gridChanged(uint32_t grid) {
-  if (grid < grids_.size() && !grids_[grid].holders.empty()) grids_[grid].whole = true;
+  if (grid >= grids_.size() || grids_[grid].holders.empty()) return;
+  grids_[grid].whole = true;
+  markDirty(grid);
 }
 
 void RenderChunks::rebuildCell(const BrickGrid& bricks, Cell& cell, std::vector<uint32_t>& scratch) const {
@@ -184,7 +195,8 @@ void RenderChunks::rebuildCell(const BrickGrid& bricks, Cell& cell, std::vector<
   cell.stale = false;
 }
 
-void RenderChunks::rebuildGrid(const BrickGrid& bricks, GridCells& g) {
+void RenderChunks::rebuildGrid(const BrickGrid& bricks, uint32_t grid) {
+  GridCells& g = grids_[grid];
   std::unordered_map<CellKey, Cell, CellKeyHash> fresh;
   bricks.forEachBrick([&](uint32_t id) {
     const Aabb box = brickBounds(bricks.brick(id));
@@ -199,7 +211,7 @@ void RenderChunks::rebuildGrid(const BrickGrid& bricks, GridCells& g) {
     cell.bricks = now.bricks;
     std::copy(std::begin(now.onFace), std::end(now.onFace), std::begin(cell.onFace));
     cell.stale = false;
-    touch(g, s);
+    touch(grid, s);
   }
   // Cells met for the first time, in cell order (the layout the render scene always had).
   std::vector<std::pair<CellKey, Cell>> added(fresh.begin(), fresh.end());
@@ -212,7 +224,7 @@ void RenderChunks::rebuildGrid(const BrickGrid& bricks, GridCells& g) {
     cell.touched = false;
     g.slotOf.insert(key, uint32_t(g.cells.size()));
     g.cells.push_back(cell);
-    touch(g, uint32_t(g.cells.size() - 1));
+    touch(grid, uint32_t(g.cells.size() - 1));
   }
 }
 
@@ -253,7 +265,7 @@ void RenderChunks::addHolder(uint32_t grid, const BrickGrid& bricks, uint32_t bo
   if (grid >= grids_.size()) grids_.resize(size_t(grid) + 1);
   GridCells& g = grids_[grid];
   if (g.holders.empty()) {
-    rebuildGrid(bricks, g);  // the first holder: the grid's cells, in cell order
+    rebuildGrid(bricks, grid);  // the first holder: the grid's cells, in cell order
     for (uint32_t s : g.touched) g.cells[s].touched = false;
     g.touched.clear();
     g.whole = false;
@@ -270,21 +282,23 @@ void RenderChunks::addHolder(uint32_t grid, const BrickGrid& bricks, uint32_t bo
 }
 
 RenderChunkStats RenderChunks::refresh(std::span<const std::unique_ptr<BrickGrid>> grids, AttachmentStore& store) {
-  RenderChunkStats stats;
-  const uint64_t acquired = acquired_;
-  for (uint32_t gi = 0; gi < grids_.size(); ++gi) {
-    GridCells& g = grids_[gi];
-    if (g.holders.empty()) continue;
+  for (uint32_t gi : dirtyGrids_)  // checked before anything changes
     if (gi >= grids.size())
       throw InvalidInput("RenderChunks::refresh: grid " + std::to_string(gi) + " has render chunks, the world has " +
                          std::to_string(grids.size()) + " grids");
+  RenderChunkStats stats;
+  const uint64_t acquired = acquired_;
+  // note: grids in index order, cells in the order they were first touched, both fixed by the
+  // serial edits: hidden attachments are reused in the same order for any thread count.
+  std::sort(dirtyGrids_.begin(), dirtyGrids_.end());
+  for (size_t k = 0; k < dirtyGrids_.size(); ++k) {  // note: rebuildGrid() below appends nothing new: the grid is dirty already
+    const uint32_t gi = dirtyGrids_[k];
+    GridCells& g = grids_[gi];
     const BrickGrid& bricks = *grids[gi];
     if (g.whole) {
-      rebuildGrid(bricks, g);
+      rebuildGrid(bricks, gi);
       g.whole = false;
     }
-    // note: in the order the cells were first touched, which the serial edits fix: the hidden
-    // attachments are reused in the same order for any thread count.
     for (uint32_t s : g.touched) {
       Cell& cell = g.cells[s];
       if (cell.stale) {
@@ -296,7 +310,9 @@ RenderChunkStats RenderChunks::refresh(std::span<const std::unique_ptr<BrickGrid
       ++stats.cellsRefreshed;
     }
     g.touched.clear();
+    g.dirty = false;
   }
+  dirtyGrids_.clear();
   stats.chunksAdded = uint32_t(acquired_ - acquired);
   return stats;
 }

@@ -110,19 +110,22 @@ class RenderChunks {
     std::vector<std::vector<uint32_t>> ids;    // [holder][slot]: attachment, or kInvalidIndex
     std::vector<uint32_t> touched;             // slots edited since the last refresh
     bool whole = false;                        // gridChanged(): rebuild every cell
+    bool dirty = false;                        // in dirtyGrids_
   };
 
   CellKey keyOf(const Aabb& brickBox) const;
   Aabb cellBox(const CellKey& key) const;
   uint32_t slot(GridCells& g, const CellKey& key);
-  void touch(GridCells& g, uint32_t slot);
+  void touch(uint32_t grid, uint32_t slot);
+  void markDirty(uint32_t grid);
   static void mergeBrick(Cell& cell, const Aabb& box);
   void rebuildCell(const BrickGrid& bricks, Cell& cell, std::vector<uint32_t>& scratch) const;
-  void rebuildGrid(const BrickGrid& bricks, GridCells& g);
+  void rebuildGrid(const BrickGrid& bricks, uint32_t grid);
   void syncCell(GridCells& g, uint32_t slot, AttachmentStore& store, RenderChunkStats& stats);
 
   float chunk_;
   std::vector<GridCells> grids_;  // by world grid index (holders empty: not rendered)
+  std::vector<uint32_t> dirtyGrids_;  // grids touched or changed since the last refresh (a refresh visits only these)
   std::vector<uint32_t> free_;    // hidden attachments, reused last-in first-out
   std::vector<uint32_t> scratch_; // brick ids of a rebuilt cell
   uint64_t acquired_ = 0;
