@@ -120,14 +120,27 @@ void AttachmentStore::setPrimitiveBounds(uint32_t id, const Aabb& localBounds) {
   localDirty_[id] = 1;
 }
 
-void AttachmentStore::rebindPrimitive(uint32_t id, uint32_t body, const Vec3f& localTranslation, const Quatf& localRotation,
-                                      const Aabb& localBounds) {
-  const char* context = "AttachmentStore::rebindPrimitive";
+void AttachmentStore::requireRebindable(uint32_t id, AttachmentKind kind, uint32_t body, const char* context) const {
   if (id >= size()) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " does not exist");
-  if (kind_[id] != AttachmentKind::Primitive) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " is a light");
+  if (kind_[id] != kind)
+    throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " is a " +
+                       (kind_[id] == AttachmentKind::Light ? "light" : "primitive"));
   if (parent_[id] != kInvalidIndex || hasChildren_[id])
     throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " is part of a hierarchy");
   if (body == UINT32_MAX) throw InvalidInput(std::string(context) + ": body index is UINT32_MAX");
+}
+
+void AttachmentStore::rebindLight(uint32_t id, uint32_t body) {
+  requireRebindable(id, AttachmentKind::Light, body, "AttachmentStore::rebindLight");
+  body_[id] = body;
+  localDirty_[id] = 1;
+  bodiesReferenced_ = std::max(bodiesReferenced_, body + 1);
+}
+
+void AttachmentStore::rebindPrimitive(uint32_t id, uint32_t body, const Vec3f& localTranslation, const Quatf& localRotation,
+                                      const Aabb& localBounds) {
+  const char* context = "AttachmentStore::rebindPrimitive";
+  requireRebindable(id, AttachmentKind::Primitive, body, context);
   requireFinite(localTranslation, context, "localTranslation");
   requireUnitQuaternion(localRotation, context, "localRotation");
   requireFiniteOrEmpty(localBounds, context);

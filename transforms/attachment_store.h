@@ -70,6 +70,10 @@ class AttachmentStore {
   /// InvalidInput otherwise.
   void rebindPrimitive(uint32_t id, uint32_t body, const Vec3f& localTranslation, const Quatf& localRotation,
                        const Aabb& localBounds);
+  /// Moves a light that rides directly on its body and carries no children to another body,
+  /// keeping its offset (a lamp on a part split off a grid, whose frame is the grid's); resent
+  /// on the next update. Throws InvalidInput otherwise.
+  void rebindLight(uint32_t id, uint32_t body);
   /// Recomputes and resends every attachment on the next update (after a frame the render side
   /// never applied, e.g. a batch overflow, so the render scene catches up in one frame).
   void markAllDirty();
@@ -122,6 +126,8 @@ class AttachmentStore {
  private:
   uint32_t add(uint32_t body, uint32_t parent, const Vec3f& t, const Quatf& r, AttachmentKind kind,
                uint32_t renderId, const Aabb& bounds, const char* context);
+  // Checks that id is a root attachment of `kind` with no children that may move to body.
+  void requireRebindable(uint32_t id, AttachmentKind kind, uint32_t body, const char* context) const;
 
   // hot: read or written by every update
   std::vector<uint32_t> body_;              // 4 per attachment

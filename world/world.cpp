@@ -390,6 +390,7 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
     for (uint32_t id : part) editLog_.bricks.push_back({g, id, false, old.brick(id)});
   if (renderChunks_)
     for (uint32_t id : part) renderChunks_->removing(g, old.brick(id));
+  const std::vector<uint32_t> lamps = lightsOnPart(g, part);  // before the part's bricks leave
   const std::vector<uint32_t> ids = old.moveBricks(part, *grid);
   auto partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   // Its centre of mass moves as that point of the old body did (v + w x r about the old body's
@@ -406,6 +407,7 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   const uint32_t body = addPartBody(std::move(grid), std::move(partLinks), debrisBricks_[g], gridNames_[g] + "/part" + std::to_string(++piecesMade_),
                                     pose, v, w);
   if (recordingEdits_) editLog_.splits.push_back({g, ng, body});
+  moveLights(g, ng, lamps);
   ++stats_.splits;
 }
 

@@ -252,8 +252,12 @@ class World {
   // Render attachments of every body (render_attachments.cpp): built once, then kept in step
   // with edits, splits and new bodies before every render frame.
   AttachmentStore buildAttachments();
-  void addBodyAttachments(uint32_t body, AttachmentStore& store);
+  void addBodyAttachments(uint32_t body, AttachmentStore& store, bool setup);
   void refreshAttachments();
+  // Lights of grid g whose nearest brick is in `part` (indices into gridLights_[g]), and
+  // handing them to the part's grid ng (render_attachments.cpp).
+  std::vector<uint32_t> lightsOnPart(uint32_t g, const std::vector<uint32_t>& part) const;
+  void moveLights(uint32_t g, uint32_t ng, const std::vector<uint32_t>& lights);
   uint32_t addGridBody(uint32_t gridIndex, const Vec3d& position, const Quatf& rotation, MotionType motion,
                        const Vec3d& linearVelocity, const Vec3f& angularVelocity);
   // Bodies that start inside solid (depenetration.cpp).
@@ -422,6 +426,8 @@ class World {
   // attachments (later ones get theirs before the next render frame).
   std::unique_ptr<RenderChunks> renderChunks_;
   uint32_t renderedBodies_ = 0;
+  std::vector<std::vector<uint32_t>> gridLightIds_;       // per grid: its lights' attachments on its first holder
+  std::vector<std::pair<uint32_t, uint32_t>> lightMoves_; // (light attachment, grid) split off since the last render frame
   // Last member: the render thread stops before anything it was fed from goes away.
   std::unique_ptr<WorldRender> render_;
 };

@@ -304,6 +304,70 @@ TEST(RenderChunksWorld, RemoveBricksAndEditGridBetweenStepsReachTheRender) {
   expectRenderFollowsWorld(world);
 }
 
+// A lamp goes with the brick nearest to it: cut a small block out around one lamp (its bricks
+// kept, a 1.5 m shell around them removed) and the lamp rides on the part that falls off, while
+// lamps elsewhere stay on the house.
+TEST(RenderChunksWorld, ALampGoesWithThePartItsNearestBrickSplitsOffIn) {
+  World world(demolitionWithAttachments(10), 1);
+  const uint32_t house = world.gridBody("house");
+  const uint32_t g = world.bodies().shape[house].grid;
+  const BrickGrid& grid = world.grid(g);
+  const AttachmentStore& store = world.render()->store();
+  const auto farthest = [](const Vec3f& p, const Aabb& b) { return (p - b.min).cwiseAbs().cwiseMax((p - b.max).cwiseAbs()).norm(); };
+  const auto nearest = [](const Vec3f& p, const Aabb& b) { return (p.cwiseMax(b.min).cwiseMin(b.max) - p).norm(); };
+  uint32_t lamp = kInvalidIndex;
+  std::vector<uint32_t> shell;
+  for (uint32_t id = 0; id < store.size() && lamp == kInvalidIndex; ++id) {
+    if (store.kind(id) != AttachmentKind::Light || store.body(id) != house) continue;
+    const Vec3f p = store.localTranslation(id);
+    std::vector<uint32_t> inner, cut;
+    grid.forEachBrick([&](uint32_t b) {
+      const Aabb box = brickBounds(grid.brick(b));
+      if (farthest(p, box) <= 1.5f) inner.push_back(b);
+      else if (nearest(p, box) <= 3.f) cut.push_back(b);
+    });
+    // Nearest brick left after the cut, within the lamp's 2 m reach: it must be an inner one.
+    float best = 2.f;
+    bool innerNearest = false;
+    grid.forEachBrick([&](uint32_t b) {
+      if (std::find(cut.begin(), cut.end(), b) != cut.end()) return;
+      const float d = nearest(p, brickBounds(grid.brick(b)));
+      if (d < best) {
+        best = d;
+        innerNearest = std::find(inner.begin(), inner.end(), b) != inner.end();
+      }
+    });
+    if (inner.size() >= 4 && innerNearest) {
+      lamp = id;
+      shell = cut;
+    }
+  }
+  ASSERT_NE(lamp, kInvalidIndex) << "no lamp of the house sits on a block that can be cut out";
+  std::vector<uint32_t> others;
+  for (uint32_t id = 0; id < store.size(); ++id)
+    if (id != lamp && store.kind(id) == AttachmentKind::Light && store.body(id) == house) others.push_back(id);
+  const Vec3f offset = store.localTranslation(lamp);
+  const World::RemovalResult cut = world.removeBricks(g, shell);
+  ASSERT_GT(cut.parts, 0u);
+  world.step();
+  const uint32_t body = store.body(lamp);
+  EXPECT_NE(body, house) << "the lamp stayed on the house";
+  ASSERT_TRUE(world.bodies().shape[body].isGrid());
+  EXPECT_NE(world.bodies().shape[body].grid, g);
+  EXPECT_EQ(store.localTranslation(lamp), offset) << "the part keeps the grid's coordinates";
+  uint32_t stayed = 0;
+  for (uint32_t id : others) stayed += store.body(id) == house;
+  EXPECT_GT(stayed, 0u) << "every other lamp left the house too";
+  expectRenderFollowsWorld(world);
+  // The lamp is drawn where the part holds it.
+  const RenderScene& scene = world.renderScene();
+  Vec3d t;
+  Quatf r;
+  const RigidTransform pose = world.bodies().shapePose(body);
+  composeAttachmentPose(pose.translation, pose.rotation, store.localTranslation(lamp), store.localRotation(lamp), t, r);
+  EXPECT_EQ(scene.lightPosition(store.renderId(lamp)), t);
+}
+
 TEST(RenderChunksWorld, SlabsBrokenOffTerrainGetProxies) {
   const SceneDescription scene = parseScene(R"({
     "name": "quarry_rendered", "settings": {"frames": 40},
