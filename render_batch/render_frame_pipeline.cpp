@@ -72,22 +72,26 @@ FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const Upda
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
     ~CommitTimer() { timing.commitMs = msSince(start); }
   };
-  // note: enqueued before the update starts, so it precedes every record of this frame in
-  // the queue (FIFO in happens-before order, which the workers' start gives).
-  if (store_.primitiveCount() > scenePrimitives_) {
+  // note: enqueued once the update's inputs were accepted (a refused update leaves nothing in
+  // the queue) and before the update starts, so it precedes every record of this frame in the
+  // queue (FIFO in happens-before order, which the workers' start gives).
+  const auto growScene = [this] {
+    if (store_.primitiveCount() <= scenePrimitives_) return;
     scenePrimitives_ = store_.primitiveCount();
     render_->enqueue(GrowScene{scenePrimitives_});
-  }
+  };
   if (batched_) {
     batched_->beginFrame(frame);
     batched_->growCurrent(batchFollowsStore_[0] ? store_.primitiveCount() : 0, batchFollowsStore_[1] ? store_.lightCount() : 0);
     TransformUpdate update(store_, bodies, *batched_);
+    growScene();
     runner(update);
     frame_ = frame;
     CommitTimer commit{timing};
     batched_->commitFrame(frame);
   } else {
     TransformUpdate update(store_, bodies, *perObject_);
+    growScene();
     runner(update);
     frame_ = frame;
     CommitTimer commit{timing};

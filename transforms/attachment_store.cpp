@@ -42,6 +42,7 @@ uint32_t AttachmentStore::add(uint32_t body, uint32_t parent, const Vec3f& t, co
   depth_.push_back(depth);
   localBounds_.push_back(bounds);
   hasChildren_.push_back(0);
+  fresh_.push_back(updated_ ? 1 : 0);
   bodiesReferenced_ = std::max(bodiesReferenced_, body + 1);
   orderDirty_ = true;
   return id;
@@ -96,6 +97,7 @@ void AttachmentStore::reserve(uint32_t n) {
   depth_.reserve(n);
   localBounds_.reserve(n);
   hasChildren_.reserve(n);
+  fresh_.reserve(n);
 }
 
 namespace {
@@ -134,6 +136,7 @@ void AttachmentStore::rebindLight(uint32_t id, uint32_t body) {
   requireRebindable(id, AttachmentKind::Light, body, "AttachmentStore::rebindLight");
   body_[id] = body;
   localDirty_[id] = 1;
+  fresh_[id] = 1;
   bodiesReferenced_ = std::max(bodiesReferenced_, body + 1);
 }
 
@@ -149,6 +152,7 @@ void AttachmentStore::rebindPrimitive(uint32_t id, uint32_t body, const Vec3f& l
   localRotation_[id] = localRotation.normalized();
   localBounds_[id] = localBounds.isEmpty() ? Aabb::empty() : localBounds;
   localDirty_[id] = 1;
+  fresh_[id] = 1;
   bodiesReferenced_ = std::max(bodiesReferenced_, body + 1);
 }
 
@@ -174,9 +178,11 @@ void AttachmentStore::prepareUpdateOrder() {
 }
 
 AttachmentColumns AttachmentStore::columns() {
+  updated_ = true;
   return {body_.data(),          parent_.data(),           kind_.data(),          renderId_.data(),
           localTranslation_.data(), localRotation_.data(), localBounds_.data(),   worldTranslation_.data(),
-          worldRotation_.data(), moved_.data(),            localDirty_.data(),    levelOrder_.data()};
+          worldRotation_.data(), moved_.data(),            localDirty_.data(),    fresh_.data(),
+          levelOrder_.data()};
 }
 
 }  // namespace bw

@@ -15,7 +15,12 @@
 /// Render ids: primitives get proxy ids 0..primitiveCount-1 and lights light ids
 /// 0..lightCount-1 in creation order; those are the render scene's indices.
 /// Hidden primitives: a primitive whose local bounds are empty (Aabb::empty()) is sent with zero
-/// extent and the render scene reports it invisible. The world hides the render chunk of a cell
+/// extent when it is hidden, and the render scene reports it invisible; while it stays hidden
+/// its moves are not sent (nothing of it is drawn).
+/// Motion vectors: the first update reports the origin as every attachment's previous pose (the
+/// object-style baseline does the same); an attachment added or rebound after that reports its
+/// first pose as its previous one, so a part split off does not streak from the origin or from
+/// the body its reused proxy rode before. The world hides the render chunk of a cell
 /// whose bricks are all gone and later rebinds it to whatever needs a new chunk, so a store
 /// grows only to the most chunks ever visible at once.
 /// Thread safety: edits (add*, set*, rebind*) only while no update runs.
@@ -48,6 +53,7 @@ struct AttachmentColumns {
   Quatf* worldRotation;            ///< world rotation, written by the update
   uint8_t* moved;                  ///< 1 if recomputed this frame (children read it)
   uint8_t* localDirty;             ///< 1 if the local offset changed since the last update
+  uint8_t* fresh;                  ///< 1 until the first record of an attachment added or rebound after the first update
   const uint32_t* levelOrder;      ///< attachment ids sorted by (depth, id)
 };
 
@@ -145,6 +151,8 @@ class AttachmentStore {
   std::vector<uint8_t> depth_;
   std::vector<Aabb> localBounds_;
   std::vector<uint8_t> hasChildren_;        // 1 once another attachment rides on it
+  std::vector<uint8_t> fresh_;              // see AttachmentColumns::fresh
+  bool updated_ = false;                    // columns() was taken for an update
   std::vector<float> lightAttenuation_;     // by light id
 
   uint32_t levelBegin_[kMaxAttachmentDepth + 1] = {};

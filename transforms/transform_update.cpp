@@ -39,22 +39,30 @@ void TransformUpdate::runBlocks(uint32_t begin, uint32_t end, UpdateRangeTimes* 
       // note: a parent is one level up, finished before this level started, so reading its
       // moved flag and pose here is race-free.
       const bool parentMoved = parent == kInvalidIndex ? bodies_.moved[body] != 0 : c.moved[parent] != 0;
-      const bool moved = parentMoved || c.localDirty[id] != 0;
+      const bool dirty = c.localDirty[id] != 0;
+      const bool moved = parentMoved || dirty;
       c.moved[id] = moved ? 1 : 0;
       if (!moved) continue;
       c.localDirty[id] = 0;
-      const Vec3d previousTranslation = c.worldTranslation[id];
-      const Quatf previousRotation = c.worldRotation[id];
+      Vec3d previousTranslation = c.worldTranslation[id];
+      Quatf previousRotation = c.worldRotation[id];
       if (parent == kInvalidIndex)
         composeAttachmentPose(bodies_.position[body], bodies_.rotation[body], c.localTranslation[id],
                               c.localRotation[id], c.worldTranslation[id], c.worldRotation[id]);
       else
         composeAttachmentPose(c.worldTranslation[parent], c.worldRotation[parent], c.localTranslation[id],
                               c.localRotation[id], c.worldTranslation[id], c.worldRotation[id]);
-      if (c.kind[id] == AttachmentKind::Primitive)
-        primitives[nPrimitives++] = makePrimitiveUpdate(c.renderId[id], c.localBounds[id], c.worldTranslation[id],
-                                                        c.worldRotation[id], previousTranslation, previousRotation);
-      else
+      if (c.fresh[id]) {  // added or rebound since the first update: no motion from a pose it never had
+        previousTranslation = c.worldTranslation[id];
+        previousRotation = c.worldRotation[id];
+        c.fresh[id] = 0;
+      }
+      if (c.kind[id] == AttachmentKind::Primitive) {
+        // note: a hidden primitive is sent once, when it is hidden; its later moves show nothing.
+        if (dirty || !c.localBounds[id].isEmpty())
+          primitives[nPrimitives++] = makePrimitiveUpdate(c.renderId[id], c.localBounds[id], c.worldTranslation[id],
+                                                          c.worldRotation[id], previousTranslation, previousRotation);
+      } else
         lights[nLights++] = makeLightUpdate(c.renderId[id], c.worldTranslation[id], c.worldRotation[id]);
     }
     Clock::time_point t1;

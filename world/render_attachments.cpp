@@ -53,9 +53,8 @@ void World::refreshAttachments() {
   AttachmentStore& store = render_->attachments();
   stats_.renderChunks = renderChunks_->refresh(grids_, store);
   const uint64_t acquired = renderChunks_->acquiredCount();
-  for (uint32_t body = renderedBodies_; body < bodies_.size(); ++body) addBodyAttachments(body, store, false);
+  for (; renderedBodies_ < bodies_.size(); ++renderedBodies_) addBodyAttachments(renderedBodies_, store, false);
   stats_.renderChunks.chunksAdded += uint32_t(renderChunks_->acquiredCount() - acquired);
-  renderedBodies_ = bodies_.size();
   for (const auto& [id, grid] : lightMoves_) store.rebindLight(id, gridBodies_[grid].front());
   lightMoves_.clear();
 }

@@ -237,27 +237,28 @@ uint32_t RenderChunks::acquire(AttachmentStore& store, uint32_t body, const Vec3
   return id;
 }
 
-void RenderChunks::syncCell(GridCells& g, uint32_t s, AttachmentStore& store, RenderChunkStats& stats) {
+void RenderChunks::hideCell(GridCells& g, uint32_t s, AttachmentStore& store, RenderChunkStats& stats) {
+  for (std::vector<uint32_t>& ids : g.ids) {
+    if (ids.size() <= s || ids[s] == kInvalidIndex) continue;
+    store.setPrimitiveBounds(ids[s], Aabb::empty());
+    free_.push_back(ids[s]);
+    ids[s] = kInvalidIndex;
+    ++stats.chunksHidden;
+  }
+}
+
+void RenderChunks::showCell(GridCells& g, uint32_t s, AttachmentStore& store) {
   const Cell& cell = g.cells[s];
+  const Vec3f c = cell.box.center();
+  const Aabb local{cell.box.min - c, cell.box.max - c};
   for (uint32_t h = 0; h < g.holders.size(); ++h) {
     std::vector<uint32_t>& ids = g.ids[h];
     if (ids.size() <= s) ids.resize(g.cells.size(), kInvalidIndex);
     uint32_t& id = ids[s];
-    if (cell.bricks == 0) {
-      if (id == kInvalidIndex) continue;
-      store.setPrimitiveBounds(id, Aabb::empty());
-      free_.push_back(id);
-      id = kInvalidIndex;
-      ++stats.chunksHidden;
-      continue;
-    }
-    const Vec3f c = cell.box.center();
-    const Aabb local{cell.box.min - c, cell.box.max - c};
-    if (id == kInvalidIndex) {
+    if (id == kInvalidIndex)
       id = acquire(store, g.holders[h], c, local);
-    } else if (store.localTranslation(id) != c || !sameBox(store.localBounds(id), local)) {
+    else if (store.localTranslation(id) != c || !sameBox(store.localBounds(id), local))
       store.rebindPrimitive(id, g.holders[h], c, Quatf::Identity(), local);
-    }
   }
 }
 
@@ -291,12 +292,13 @@ RenderChunkStats RenderChunks::refresh(std::span<const std::unique_ptr<BrickGrid
   // note: grids in index order, cells in the order they were first touched, both fixed by the
   // serial edits: hidden attachments are reused in the same order for any thread count.
   std::sort(dirtyGrids_.begin(), dirtyGrids_.end());
-  for (size_t k = 0; k < dirtyGrids_.size(); ++k) {  // note: rebuildGrid() below appends nothing new: the grid is dirty already
-    const uint32_t gi = dirtyGrids_[k];
+  // Two passes: every emptied cell's attachments are hidden (and free) before any cell takes
+  // one, so the store grows only when more chunks are visible at once than ever before.
+  for (uint32_t gi : dirtyGrids_) {
     GridCells& g = grids_[gi];
     const BrickGrid& bricks = *grids[gi];
     if (g.whole) {
-      rebuildGrid(bricks, gi);
+      rebuildGrid(bricks, gi);  // note: the grid is dirty already: dirtyGrids_ does not grow
       g.whole = false;
     }
     for (uint32_t s : g.touched) {
@@ -305,7 +307,14 @@ RenderChunkStats RenderChunks::refresh(std::span<const std::unique_ptr<BrickGrid
         rebuildCell(bricks, cell, scratch_);
         ++stats.cellsRecomputed;
       }
-      syncCell(g, s, store, stats);
+      if (cell.bricks == 0) hideCell(g, s, store, stats);
+    }
+  }
+  for (uint32_t gi : dirtyGrids_) {
+    GridCells& g = grids_[gi];
+    for (uint32_t s : g.touched) {
+      Cell& cell = g.cells[s];
+      if (cell.bricks != 0) showCell(g, s, store);
       cell.touched = false;
       ++stats.cellsRefreshed;
     }

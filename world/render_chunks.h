@@ -121,7 +121,8 @@ class RenderChunks {
   static void mergeBrick(Cell& cell, const Aabb& box);
   void rebuildCell(const BrickGrid& bricks, Cell& cell, std::vector<uint32_t>& scratch) const;
   void rebuildGrid(const BrickGrid& bricks, uint32_t grid);
-  void syncCell(GridCells& g, uint32_t slot, AttachmentStore& store, RenderChunkStats& stats);
+  void hideCell(GridCells& g, uint32_t slot, AttachmentStore& store, RenderChunkStats& stats);
+  void showCell(GridCells& g, uint32_t slot, AttachmentStore& store);
 
   float chunk_;
   std::vector<GridCells> grids_;  // by world grid index (holders empty: not rendered)

@@ -388,10 +388,10 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   auto grid = std::make_unique<BrickGrid>(BrickGrid::Config(uint32_t(part.size() + 1024)));
   if (recordingEdits_)
     for (uint32_t id : part) editLog_.bricks.push_back({g, id, false, old.brick(id)});
-  if (renderChunks_)
-    for (uint32_t id : part) renderChunks_->removing(g, old.brick(id));
   const std::vector<uint32_t> lamps = lightsOnPart(g, part);  // before the part's bricks leave
   const std::vector<uint32_t> ids = old.moveBricks(part, *grid);
+  if (renderChunks_)  // the bricks as they were, now in the part's grid
+    for (uint32_t id : ids) renderChunks_->removing(g, grid->brick(id));
   auto partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   // Its centre of mass moves as that point of the old body did (v + w x r about the old body's
   // centre; a kinematic grid turns about its origin, which is its position); a static grid's

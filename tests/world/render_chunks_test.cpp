@@ -148,6 +148,37 @@ TEST(RenderChunks, FollowRandomEditsExactlyAndReuseHiddenChunks) {
   }
 }
 
+// A frame that fills a new cell before it empties another (touch order) reuses the emptied
+// cell's primitive: hiding runs before any cell takes one, across grids too.
+TEST(RenderChunks, AFrameThatFillsOneCellAndEmptiesAnotherDoesNotGrowTheStore) {
+  std::vector<std::unique_ptr<BrickGrid>> grids;
+  for (int i = 0; i < 2; ++i) grids.push_back(std::make_unique<BrickGrid>());
+  const uint32_t a = grids[0]->placeBrick(Brick::box(Vec3f(0.5f, 0.5f, 0.5f), Vec3f::Constant(0.25f)));
+  grids[1]->placeBrick(Brick::box(Vec3f(0.5f, 0.5f, 0.5f), Vec3f::Constant(0.25f)));
+  const uint32_t b = grids[1]->placeBrick(Brick::box(Vec3f(5.5f, 0.5f, 0.5f), Vec3f::Constant(0.25f)));
+  AttachmentStore store;
+  RenderChunks chunks(1.f);
+  chunks.addHolder(0, *grids[0], 0, store);
+  chunks.addHolder(1, *grids[1], 1, store);
+  ASSERT_EQ(store.primitiveCount(), 3u);
+  // Grid 0 (refreshed first) gains a cell; grid 1 loses one; then grid 1 itself both gains and
+  // loses one, gaining first.
+  chunks.placed(0, grids[0]->brick(grids[0]->placeBrick(Brick::box(Vec3f(3.5f, 0.5f, 0.5f), Vec3f::Constant(0.25f)))));
+  chunks.removing(1, grids[1]->brick(b));
+  grids[1]->removeBrick(b);
+  chunks.refresh(grids, store);
+  EXPECT_EQ(store.primitiveCount(), 3u);
+  EXPECT_EQ(visibleChunks(store, 0), bruteChunks(*grids[0], 1.f));
+  EXPECT_EQ(visibleChunks(store, 1), bruteChunks(*grids[1], 1.f));
+  chunks.placed(1, grids[1]->brick(grids[1]->placeBrick(Brick::box(Vec3f(8.5f, 0.5f, 0.5f), Vec3f::Constant(0.25f)))));
+  chunks.removing(0, grids[0]->brick(a));
+  grids[0]->removeBrick(a);
+  chunks.refresh(grids, store);
+  EXPECT_EQ(store.primitiveCount(), 3u);
+  EXPECT_EQ(visibleChunks(store, 0), bruteChunks(*grids[0], 1.f));
+  EXPECT_EQ(visibleChunks(store, 1), bruteChunks(*grids[1], 1.f));
+}
+
 TEST(RenderChunks, BadInputIsRefused) {
   EXPECT_THROW(RenderChunks(0.f), InvalidInput);
   EXPECT_THROW(RenderChunks(std::nanf("")), InvalidInput);
@@ -186,6 +217,7 @@ void expectRenderFollowsWorld(World& world) {
     const WorldMatrix m = makeWorldMatrix(t, r);
     const uint32_t rid = store.renderId(id);
     ASSERT_EQ(scene.visible(rid), !store.localBounds(id).isEmpty()) << "proxy " << rid;
+    if (!scene.visible(rid)) continue;  // a hidden proxy is not sent again while it stays hidden
     ASSERT_EQ(std::memcmp(&scene.localToWorldTranslation(rid), &m.translation, sizeof(Vec3d)), 0) << "proxy " << rid;
     const WorldBounds b = makeWorldBounds(store.localBounds(id), m);
     ASSERT_EQ(std::memcmp(&scene.boundsOrigin(rid), &b.origin, sizeof(Vec3d)), 0) << "proxy " << rid;
@@ -366,6 +398,16 @@ TEST(RenderChunksWorld, ALampGoesWithThePartItsNearestBrickSplitsOffIn) {
   const RigidTransform pose = world.bodies().shapePose(body);
   composeAttachmentPose(pose.translation, pose.rotation, store.localTranslation(lamp), store.localRotation(lamp), t, r);
   EXPECT_EQ(scene.lightPosition(store.renderId(lamp)), t);
+  // The part's chunks, drawn for the first time (new or reused proxies): no motion from where
+  // a reused proxy was, nor from the origin.
+  uint32_t partChunks = 0;
+  for (uint32_t id = 0; id < store.size(); ++id) {
+    if (store.kind(id) != AttachmentKind::Primitive || store.body(id) != body) continue;
+    ++partChunks;
+    const uint32_t rid = store.renderId(id);
+    EXPECT_EQ(scene.previousTranslation(rid), scene.localToWorldTranslation(rid)) << "proxy " << rid;
+  }
+  EXPECT_GT(partChunks, 0u);
 }
 
 TEST(RenderChunksWorld, SlabsBrokenOffTerrainGetProxies) {
