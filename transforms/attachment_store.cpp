@@ -4,6 +4,7 @@
 #include <string>
 
 #include "collision/core/argument_checks.h"
+#include "transforms/attachment_math.h"
 
 namespace bw {
 
@@ -118,7 +119,7 @@ void AttachmentStore::setPrimitiveBounds(uint32_t id, const Aabb& localBounds) {
   if (id >= size()) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " does not exist");
   if (kind_[id] != AttachmentKind::Primitive) throw InvalidInput(std::string(context) + ": attachment " + std::to_string(id) + " is a light");
   requireFiniteOrEmpty(localBounds, context);
-  localBounds_[id] = localBounds.isEmpty() ? Aabb::empty() : localBounds;
+  localBounds_[id] = localBounds.isEmpty() ? hiddenBounds() : localBounds;
   localDirty_[id] = 1;
 }
 
@@ -150,7 +151,7 @@ void AttachmentStore::rebindPrimitive(uint32_t id, uint32_t body, const Vec3f& l
   body_[id] = body;
   localTranslation_[id] = localTranslation;
   localRotation_[id] = localRotation.normalized();
-  localBounds_[id] = localBounds.isEmpty() ? Aabb::empty() : localBounds;
+  localBounds_[id] = localBounds.isEmpty() ? hiddenBounds() : localBounds;
   localDirty_[id] = 1;
   fresh_[id] = 1;
   bodiesReferenced_ = std::max(bodiesReferenced_, body + 1);

@@ -14,7 +14,8 @@
 /// child reads it, without locks. The level order is rebuilt only when attachments are added.
 /// Render ids: primitives get proxy ids 0..primitiveCount-1 and lights light ids
 /// 0..lightCount-1 in creation order; those are the render scene's indices.
-/// Hidden primitives: a primitive whose local bounds are empty (Aabb::empty()) is sent with zero
+/// Hidden primitives: a primitive whose local bounds are empty (stored as hiddenBounds(),
+/// attachment_math.h) is sent with zero
 /// extent when it is hidden, and the render scene reports it invisible; while it stays hidden
 /// its moves are not sent (nothing of it is drawn).
 /// Motion vectors: the first update reports the origin as every attachment's previous pose (the

@@ -59,9 +59,11 @@ void TransformUpdate::runBlocks(uint32_t begin, uint32_t end, UpdateRangeTimes* 
       }
       if (c.kind[id] == AttachmentKind::Primitive) {
         // note: a hidden primitive is sent once, when it is hidden; its later moves show nothing.
-        if (dirty || !c.localBounds[id].isEmpty())
-          primitives[nPrimitives++] = makePrimitiveUpdate(c.renderId[id], c.localBounds[id], c.worldTranslation[id],
-                                                          c.worldRotation[id], previousTranslation, previousRotation);
+        // The record is made either way and just not kept: made under a condition, GCC stopped
+        // inlining makePrimitiveUpdate, and carrier_fleet's update took 20% longer.
+        primitives[nPrimitives] = makePrimitiveUpdate(c.renderId[id], c.localBounds[id], c.worldTranslation[id],
+                                                      c.worldRotation[id], previousTranslation, previousRotation);
+        nPrimitives += (dirty || !c.localBounds[id].isEmpty()) ? 1 : 0;
       } else
         lights[nLights++] = makeLightUpdate(c.renderId[id], c.worldTranslation[id], c.worldRotation[id]);
     }

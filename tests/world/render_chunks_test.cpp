@@ -194,7 +194,8 @@ TEST(RenderChunks, BadInputIsRefused) {
   store.setPrimitiveBounds(hull, Aabb::empty());
   EXPECT_TRUE(store.localBounds(hull).isEmpty());
   // A hidden primitive's record: zero extent at its origin, never the infinities of its corners.
-  const WorldBounds b = makeWorldBounds(Aabb::empty(), makeWorldMatrix(Vec3d(1, 2, 3), Quatf::Identity()));
+  EXPECT_TRUE(store.localBounds(hull).min.allFinite() && store.localBounds(hull).max.allFinite());
+  const WorldBounds b = makeWorldBounds(store.localBounds(hull), makeWorldMatrix(Vec3d(1, 2, 3), Quatf(Eigen::AngleAxisf(0.7f, Vec3f::UnitZ()))));
   EXPECT_EQ(b.origin, Vec3d(1, 2, 3));
   EXPECT_EQ(b.extent, Vec3f::Zero());
   EXPECT_EQ(b.radius, 0.f);
