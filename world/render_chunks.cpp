@@ -18,8 +18,6 @@ int64_t cellCoordinate(float centre, float chunk) {
   return int64_t(std::clamp(c, -4e18, 4e18));
 }
 
-bool sameBox(const Aabb& a, const Aabb& b) { return a.min == b.min && a.max == b.max; }
-
 }  // namespace
 
 size_t RenderChunks::CellKeyHash::operator()(const CellKey& k) const {
@@ -257,7 +255,7 @@ void RenderChunks::showCell(GridCells& g, uint32_t s, AttachmentStore& store) {
     uint32_t& id = ids[s];
     if (id == kInvalidIndex)
       id = acquire(store, g.holders[h], c, local);
-    else if (store.localTranslation(id) != c || !sameBox(store.localBounds(id), local))
+    else if (store.localTranslation(id) != c || !(store.localBounds(id) == local))
       store.rebindPrimitive(id, g.holders[h], c, Quatf::Identity(), local);
   }
 }
