@@ -142,9 +142,9 @@ void backOff(uint32_t spins) {
   }
 }
 
-// One wave's counters, on a cache line of their own (every thread takes chunks from them).
-struct alignas(64) WaveCounters {
-  std::atomic<uint32_t> taken{0}, finished{0};
+// One wave's finish counter, on a cache line of its own (every chunk's thread adds to it).
+struct alignas(64) WaveCounter {
+  std::atomic<uint32_t> finished{0};
 };
 }  // namespace
 
@@ -155,9 +155,21 @@ void JobSystem::parallelWaves(const std::vector<uint32_t>& chunksOf, const std::
       for (uint32_t c = 0; c < chunksOf[w]; ++c) body(w, c);
     return;
   }
-  std::unique_ptr<WaveCounters[]> counters(new WaveCounters[waves]);
+  // Member m owns the m-th contiguous slice of every wave's chunks and runs it first, then
+  // takes what is left of the other slices. A wave's chunks are in the island's order, so the
+  // same slice of successive waves touches mostly the same contacts and bodies: they stay in one
+  // core's cache instead of moving between cores every wave (dynamic taking, as before, made the
+  // coloured solve's work 24-34% larger on two threads than on one, this 8-26%: crate_pile,
+  // profiles/RESULTS.md session 20).
+  // claims[m * waves + w] counts the chunks taken from member m's slice of wave w; one member's
+  // counters lie together, so the owner's claims share its lines and a thief touches one line.
+  const uint32_t members = uint32_t(threads_);
+  std::unique_ptr<WaveCounter[]> finished(new WaveCounter[waves]);
+  std::unique_ptr<std::atomic<uint32_t>[]> claims(new std::atomic<uint32_t>[size_t(members) * waves]);
+  for (size_t i = 0; i < size_t(members) * waves; ++i) claims[i].store(0, std::memory_order_relaxed);
   std::atomic<uint32_t> completed{0};  // waves [0, completed) are finished
-  const auto member = [&](uint32_t) {
+  const auto sliceBegin = [&](uint32_t w, uint32_t m) { return uint32_t(uint64_t(chunksOf[w]) * m / members); };
+  const auto member = [&](uint32_t m) {
     for (uint32_t w = 0; w < waves; ++w) {
       for (uint32_t spins = 0; completed.load(std::memory_order_acquire) < w; ++spins) backOff(spins);
       if (chunksOf[w] == 0) {  // nothing to run: the first thread here finishes it
@@ -165,14 +177,18 @@ void JobSystem::parallelWaves(const std::vector<uint32_t>& chunksOf, const std::
         completed.compare_exchange_strong(expected, w + 1, std::memory_order_acq_rel);
         continue;
       }
-      for (;;) {
-        const uint32_t c = counters[w].taken.fetch_add(1, std::memory_order_relaxed);
-        if (c >= chunksOf[w]) break;
-        body(w, c);
-        // The last chunk's thread opens the next wave; its release (after every finisher's,
-        // through the counter) makes the wave's writes visible to whoever takes the next one.
-        if (counters[w].finished.fetch_add(1, std::memory_order_acq_rel) + 1 == chunksOf[w])
-          completed.store(w + 1, std::memory_order_release);
+      for (uint32_t k = 0; k < members; ++k) {
+        const uint32_t owner = (m + k) % members;
+        const uint32_t begin = sliceBegin(w, owner), size = sliceBegin(w, owner + 1) - begin;
+        for (;;) {
+          const uint32_t i = claims[size_t(owner) * waves + w].fetch_add(1, std::memory_order_relaxed);
+          if (i >= size) break;
+          body(w, begin + i);
+          // The last chunk's thread opens the next wave; its release (after every finisher's,
+          // through the counter) makes the wave's writes visible to whoever runs the next one.
+          if (finished[w].finished.fetch_add(1, std::memory_order_acq_rel) + 1 == chunksOf[w])
+            completed.store(w + 1, std::memory_order_release);
+        }
       }
     }
   };

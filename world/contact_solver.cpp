@@ -94,7 +94,7 @@ SolverContact ContactSolver::makeContact(const BodyStore& bodies, const BodyPair
   // push-out, so no push-out velocity survives into the next step (resting stacks stay put).
   s.relaxBias = s.depth >= 0.f ? bounce : s.depth / dt;
   // Warm start from the nearest cached impulse of the same pair and feature.
-  const CachedImpulse key{s.pairKey, s.feature, {}, 0, 0, 0};
+  const CachedImpulse key{s.pairKey, s.feature, 0, {}, 0, 0, 0};
   auto range = std::equal_range(cache_.begin(), cache_.end(), key);
   double best = kWarmStartRadius * kWarmStartRadius;
   for (auto it = range.first; it != range.second; ++it) {
@@ -112,6 +112,7 @@ SolverContact ContactSolver::makeContact(const BodyStore& bodies, const BodyPair
 void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs,
                             const std::vector<std::vector<Contact>>& pairContacts, const std::vector<uint8_t>& flipped,
                             const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler, int stage) {
+  coloured_ = false;  // new contacts: the split islands are coloured again
   const uint32_t n = bodies.size();
   inverseInertiaWorld_.resize(n);
   jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
@@ -292,16 +293,15 @@ int32_t waveStage(int stage, uint32_t& wave) { return kWaveStageBase + stage * i
 
 // One big island (a pile) on every thread: colour by colour, each colour's contacts in parallel.
 // Iterations alternate the colour order like solveIsland alternates the contact order.
-void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, const std::vector<MotionType>& motion, bool relax,
-                                         const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage,
-                                         uint32_t& wave) {
+void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, IslandColouring& colouring, bool coloured,
+                                         const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
+                                         JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave) {
   const char* const name = relax ? "relax: colour" : "colour";
-  uint32_t colours = 0;
-  {
+  if (!coloured) {
     ProfileZone zone(profiler, relax ? "relax: colouring" : "colouring", waveStage(stage, wave), true);
-    colouring_.colour(island, contacts_, motion);
-    colours = colouring_.colours();
+    colouring.colour(island, contacts_, motion);
   }
+  const uint32_t colours = colouring.colours();
   // Every pass over the colours in order, as waves of one parallel region: each colour's
   // contacts in parallel (no two share a dynamic body), the serial group as one chunk. A
   // wave starts when the one before has finished, as a fork-join per colour would, without
@@ -318,18 +318,18 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, const
     for (uint32_t i = 0; i < colours; ++i) {
       const uint32_t c = reversed ? colours - 1 - i : i;
       waves.push_back({c, waveStage(stage, wave), warmStart});
-      const uint32_t size = uint32_t(colouring_.colour(c).size());
+      const uint32_t size = uint32_t(colouring.colour(c).size());
       chunks.push_back(c == kMaxColours ? (size > 0 ? 1u : 0u) : JobSystem::chunkCount(0, size, kColourGrain));
     }
   };
   // note: colour by colour, each body gets its contacts' warm-start impulses in the order of
-  // colouring_.all(), as a serial pass over it would: the result is the same.
+  // colouring.all(), as a serial pass over it would: the result is the same.
   if (!relax) pass(true, false);
   const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
   for (int it = 0; it < iterations; ++it) pass(false, it & 1);
   jobs.parallelWaves(chunks, [&](uint32_t w, uint32_t chunk) {
     const Wave& v = waves[w];
-    const std::span<const uint32_t> group = colouring_.colour(v.colour);
+    const std::span<const uint32_t> group = colouring.colour(v.colour);
     const bool serial = v.colour == kMaxColours;  // the serial group: contacts may share bodies
     const uint32_t begin = serial ? 0 : chunk * kColourGrain;
     const uint32_t end = serial ? uint32_t(group.size()) : std::min(uint32_t(group.size()), begin + kColourGrain);
@@ -343,7 +343,7 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, const
   });
   if (!relax && settings.shockPropagation) {  // one serial sweep over the whole pile
     ProfileZone zone(profiler, "shock sweep", waveStage(stage, wave), true);
-    std::vector<uint32_t> list(colouring_.all().begin(), colouring_.all().end());
+    std::vector<uint32_t> list(colouring.all().begin(), colouring.all().end());
     shockSweep(list);
   }
 }
@@ -357,11 +357,15 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
   SolveStats stats;
   smallIslands_.clear();
   uint32_t wave = 0;
+  // The relax pass solves the same islands over the same contacts: it reuses their colourings.
+  const bool reuse = relax && coloured_;
   for (uint32_t i = 0; i < islands.count(); ++i) {
     const uint32_t size = uint32_t(islands.contacts(i).size());
     stats.largestIsland = std::max(stats.largestIsland, size);
     if (size > kSplitContacts) {
-      solveIslandInColours(islands.contacts(i), motion, relax, settings, jobs, profiler, stage + (relax ? 5 : 3), wave);
+      if (stats.splitIslands == colourings_.size()) colourings_.emplace_back();
+      solveIslandInColours(islands.contacts(i), colourings_[stats.splitIslands], reuse, motion, relax, settings, jobs,
+                           profiler, stage + (relax ? 5 : 3), wave);
       ++stats.splitIslands;
     } else {
       smallIslands_.push_back(i);
@@ -371,14 +375,35 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
     ProfileZone zone(profiler, relax ? "relax" : "island", stage + (relax ? 5 : 3));
     for (uint32_t i = b; i < e; ++i) solveIsland(islands.contacts(smallIslands_[i]), relax, settings);
   });
-  if (relax) {
-    // The final impulses warm-start the next substep.
-    nextCache_.clear();
-    for (const SolverContact& s : contacts_) nextCache_.push_back({s.pairKey, s.feature, s.point, s.lambdaN, s.lambdaT1, s.lambdaT2});
-    std::stable_sort(nextCache_.begin(), nextCache_.end());
-    std::swap(cache_, nextCache_);
-  }
+  coloured_ = !relax;
   return stats;
+}
+
+void ContactSolver::keepImpulses(JobSystem& jobs, Profiler& profiler, int stage) {
+  // The copy notes whether the contacts already come in pair and feature order (they are made
+  // pair by pair; in 4-27% of the shipped scenes' frames that is already sorted): then the sort
+  // (a sample sort; serial it took 1% of crate_pile) is skipped. The contact's index breaks
+  // ties, so either way the list is what a stable sort by pair and feature gives.
+  const uint32_t n = uint32_t(contacts_.size());
+  const uint32_t grain = std::max(1024u, (n + 63) / 64);
+  nextCache_.resize(n);
+  cacheChunkSorted_.assign(JobSystem::chunkCount(0, n, grain), 1);
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler, "solver: keep impulses", stage);
+    bool sorted = true;
+    for (uint32_t i = begin; i < end; ++i) {
+      const SolverContact& s = contacts_[i];
+      nextCache_[i] = {s.pairKey, s.feature, i, s.point, s.lambdaN, s.lambdaT1, s.lambdaT2};
+      if (i > 0) {
+        const SolverContact& p = contacts_[i - 1];
+        sorted &= p.pairKey < s.pairKey || (p.pairKey == s.pairKey && p.feature <= s.feature);
+      }
+    }
+    cacheChunkSorted_[begin / grain] = sorted;
+  });
+  if (std::find(cacheChunkSorted_.begin(), cacheChunkSorted_.end(), 0) != cacheChunkSorted_.end())
+    cacheSorter_.sort(nextCache_, false, jobs, &profiler, "solver: sort impulses", stage + 1);
+  std::swap(cache_, nextCache_);
 }
 
 }  // namespace bw

@@ -13,6 +13,7 @@
 
 #include "collision/bricks/contact.h"
 #include "jobs/job_system.h"
+#include "jobs/parallel_sort.h"
 #include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/broadphase.h"
@@ -48,10 +49,15 @@ class ContactSolver {
 
   /// Warm start (not when relaxing) and iterate every island: islands above kSplitContacts
   /// first, one at a time, colour by colour on every thread; then the others whole, in
-  /// parallel. `relax`: the pass after integration, without push-out, which also keeps the
-  /// final impulses for the next substep's warm start. `stage` is the profiling stage id.
+  /// parallel. `relax`: the pass after integration, without push-out; it reuses the colourings
+  /// of the solve before it (same islands, same contacts). `stage` is the profiling stage id.
   SolveStats solve(const Islands& islands, const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
                    JobSystem& jobs, Profiler& profiler, int stage);
+
+  /// Keeps the contacts' final impulses for the next substep's warm start (after the relax
+  /// pass), sorted by pair and feature in parallel: zones at stages `stage` (the copy) and
+  /// `stage` + 1 .. `stage` + 4 (the sort's four steps).
+  void keepImpulses(JobSystem& jobs, Profiler& profiler, int stage);
 
  private:
   /// Fewest pairs per job of prepare(): a contact costs ~100 ns, a pair up to manifoldSize of
@@ -68,8 +74,18 @@ class ContactSolver {
   void solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings);
   // `wave` numbers the island's waves (colours and serial steps, each a dependent step of
   // the solve) across the islands of one solve, for their profiling stages.
-  void solveIslandInColours(std::span<const uint32_t> island, const std::vector<MotionType>& motion, bool relax,
-                            const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave);
+  // `colouring` is the island's colouring, made here unless `coloured` (the relax pass reuses
+  // the solve's).
+  void solveIslandInColours(std::span<const uint32_t> island, IslandColouring& colouring, bool coloured,
+                            const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
+                            JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave);
+  // The cache's order: pair, feature, then the contact's index (what a stable sort by pair and
+  // feature gives, as a strict total order the parallel sort needs).
+  struct CacheOrder {
+    bool operator()(const CachedImpulse& x, const CachedImpulse& y) const {
+      return x < y || (!(y < x) && x.contact < y.contact);
+    }
+  };
 
   std::vector<SolverContact> contacts_;
   std::vector<SolverBody> bodies_;
@@ -77,7 +93,12 @@ class ContactSolver {
   std::vector<uint32_t> first_;             // prepare(): pair k's contacts start at first_[k]
   std::vector<CachedImpulse> cache_, nextCache_;
   std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
-  IslandColouring colouring_;               // of the large island being solved
+  // The colourings of this substep's split islands, in solve order; valid for the relax pass
+  // once the solve has made them (coloured_; prepare() resets it).
+  std::vector<IslandColouring> colourings_;
+  bool coloured_ = false;
+  ParallelSorter<CachedImpulse, CacheOrder> cacheSorter_;
+  std::vector<uint8_t> cacheChunkSorted_;  // keepImpulses: per copy chunk, already in order
 };
 
 }  // namespace bw

@@ -49,6 +49,7 @@ static_assert(sizeof(SolverBody) == 32);
 struct CachedImpulse {
   uint64_t pairKey;
   uint32_t feature;
+  uint32_t contact;  // the contact's index this substep: orders a pair's repeated features
   Vec3d point;
   float n, t1, t2;
   bool operator<(const CachedImpulse& o) const { return pairKey < o.pairKey || (pairKey == o.pairKey && feature < o.feature); }

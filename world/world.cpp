@@ -202,6 +202,7 @@ void World::substep(float dt, int index) {
     ProfileZone z(profiler_, "relax (stage)");
     solver_.solve(islands_, bodies_.motion, true, scene_.settings, jobs_, profiler_, stage);
     solver_.storeBodies(bodies_, jobs_, profiler_, stage + kContactStepsStage + 6);
+    solver_.keepImpulses(jobs_, profiler_, stage + kContactStepsStage + 14);
   }
   stats_.solverMs += msSince(t);
   if (scene_.settings.sleeping) sleep_.update(bodies_, islands_, dt, jobs_, profiler_, stage + 7);

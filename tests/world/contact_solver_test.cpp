@@ -37,6 +37,7 @@ void solveOnce(ContactSolver& solver, BodyStore& bodies, const std::vector<BodyP
   solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
   solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);
   solver.storeBodies(bodies, jobs, profiler);
+  solver.keepImpulses(jobs, profiler, 0);
 }
 
 TEST(ContactSolver, WarmStartMatchesPairAndFeatureAtFullWidth) {
