@@ -180,8 +180,12 @@ void JobSystem::parallelWaves(const std::vector<uint32_t>& chunksOf, const std::
       for (uint32_t k = 0; k < members; ++k) {
         const uint32_t owner = (m + k) % members;
         const uint32_t begin = sliceBegin(w, owner), size = sliceBegin(w, owner + 1) - begin;
+        std::atomic<uint32_t>& claim = claims[size_t(owner) * waves + w];
+        // note: a slice that is empty or taken costs a read, not a write to its owner's line
+        // (with 16 threads on a wave of 4 chunks most slices are empty).
+        if (size == 0 || claim.load(std::memory_order_relaxed) >= size) continue;
         for (;;) {
-          const uint32_t i = claims[size_t(owner) * waves + w].fetch_add(1, std::memory_order_relaxed);
+          const uint32_t i = claim.fetch_add(1, std::memory_order_relaxed);
           if (i >= size) break;
           body(w, begin + i);
           // The last chunk's thread opens the next wave; its release (after every finisher's,
