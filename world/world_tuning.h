@@ -134,6 +134,12 @@ inline constexpr uint32_t kRoundTrianglesPerPiece = 32;
 /// Rays per job in the scene's ray load.
 inline constexpr uint32_t kRayGrain = 64;
 
+// --- Splits -------------------------------------------------------------------------------
+/// From this many bricks a part's grid is built on one thread while the old grid lets its
+/// bricks go on another (World::makeBodyOfPart): each half then costs milliseconds, against the
+/// few microseconds of waking a thread; below it the three steps run in turn.
+inline constexpr uint32_t kParallelPartBricks = 2048;
+
 // --- Sleeping -----------------------------------------------------------------------------
 /// An island whose bodies all stayed below these speeds (m/s, rad/s) for kSleepTime (s) sleeps.
 inline constexpr float kSleepLinear = 0.05f, kSleepAngular = 0.1f, kSleepTime = 0.5f;

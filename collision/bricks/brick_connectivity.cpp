@@ -10,6 +10,7 @@ namespace bw {
 
 namespace {
 constexpr uint32_t kMaxBricksPerTurn = 64;
+constexpr size_t kListsAhead = 4;
 }  // namespace
 
 float BrickConnectivity::toleranceAt(const Aabb& a) {
@@ -34,9 +35,7 @@ bool BrickConnectivity::touches(const Aabb& a, const Aabb& b) {
 }
 
 BrickConnectivity::BrickConnectivity(const BrickGrid& grid) {
-  grid.forEachBrick([&](uint32_t id) {
-    if (id >= adjacency_.size()) adjacency_.resize(size_t(id) + 1);
-  });
+  grid.forEachBrick([&](uint32_t id) { adjacency_.grow(id + 1); });
   live_.assign(adjacency_.size(), 0);
   grid.forEachBrick([&](uint32_t id) {
     live_[id] = 1;
@@ -61,32 +60,36 @@ BrickConnectivity::BrickConnectivity(BrickConnectivity& from, std::span<const ui
       throw InvalidInput(std::string(context) + ": brick " + std::to_string(oldIds[k]) + " is not linked");
     renumber[oldIds[k]] = newIds[k];
   }
-  for (uint32_t id : oldIds)
-    for (uint32_t n : from.adjacency_[id])
-      if (renumber[n] == ~0u) throw InvalidInput(std::string(context) + ": brick " + std::to_string(id) + " has a neighbour outside the part");
-  adjacency_.resize(top);
+  // note: the ids come in the search's order, a cache miss per list: asked for ahead.
+  constexpr size_t kAhead = 8;
+  for (size_t k = 0; k < oldIds.size(); ++k) {
+    if (k + kAhead < oldIds.size()) from.adjacency_.prefetch(oldIds[k + kAhead]);
+    for (uint32_t n : from.adjacency_[oldIds[k]])
+      if (renumber[n] == ~0u)
+        throw InvalidInput(std::string(context) + ": brick " + std::to_string(oldIds[k]) + " has a neighbour outside the part");
+  }
+  adjacency_.grow(top);
   live_.assign(top, 0);
   for (size_t k = 0; k < oldIds.size(); ++k) {
-    std::vector<uint32_t>& list = adjacency_[newIds[k]];
-    list = std::move(from.adjacency_[oldIds[k]]);
-    from.adjacency_[oldIds[k]].clear();
+    if (k + kAhead < oldIds.size()) from.adjacency_.prefetch(oldIds[k + kAhead]);
+    adjacency_.takeFrom(from.adjacency_, oldIds[k], newIds[k]);
     from.live_[oldIds[k]] = 0;
-    for (uint32_t& n : list) n = renumber[n];
+    for (uint32_t& n : adjacency_.mutableList(newIds[k])) n = renumber[n];
     live_[newIds[k]] = 1;
   }
 }
 
 void BrickConnectivity::link(uint32_t a, uint32_t b) {
-  adjacency_[a].push_back(b);
-  adjacency_[b].push_back(a);
+  adjacency_.append(a, b);
+  adjacency_.append(b, a);
 }
 
 void BrickConnectivity::placed(const BrickGrid& grid, uint32_t id) {
   if (id >= adjacency_.size()) {
-    adjacency_.resize(size_t(id) + 1);
+    adjacency_.grow(id + 1);
     live_.resize(size_t(id) + 1, 0);
   }
-  adjacency_[id].clear();
+  adjacency_.clear(id);
   live_[id] = 1;
   const Aabb box = brickBounds(grid.brick(id));
   scratch_.clear();
@@ -100,11 +103,10 @@ void BrickConnectivity::placed(const BrickGrid& grid, uint32_t id) {
 void BrickConnectivity::removing(uint32_t id, std::vector<uint32_t>& seeds) {
   if (id >= adjacency_.size() || !live_[id]) return;
   for (uint32_t n : adjacency_[id]) {
-    std::vector<uint32_t>& list = adjacency_[n];
-    list.erase(std::find(list.begin(), list.end(), id));  // keeps the list's order
+    adjacency_.erase(n, id);  // keeps the list's order
     seeds.push_back(n);
   }
-  adjacency_[id].clear();
+  adjacency_.clear(id);
   live_[id] = 0;
 }
 
@@ -131,12 +133,9 @@ void BrickConnectivity::detached(std::span<const uint32_t> seeds, std::vector<st
     if (stats) *stats = st;
     return;
   }
-  if (stamp_.size() < adjacency_.size()) {
-    stamp_.resize(adjacency_.size(), 0);
-    owner_.resize(adjacency_.size(), 0);
-  }
+  if (marks_.size() < adjacency_.size()) marks_.resize(adjacency_.size());
   if (++epoch_ == 0) {  // the stamps wrapped: clear them once
-    std::fill(stamp_.begin(), stamp_.end(), 0);
+    for (Mark& m : marks_) m.stamp = 0;
     epoch_ = 1;
   }
   if (queues_.size() < k) queues_.resize(k);
@@ -146,8 +145,7 @@ void BrickConnectivity::detached(std::span<const uint32_t> seeds, std::vector<st
   for (uint32_t i = 0; i < k; ++i) {
     parent_[i] = i;
     queues_[i].assign(1, scratch_[i]);
-    stamp_[scratch_[i]] = epoch_;
-    owner_[scratch_[i]] = i;
+    marks_[scratch_[i]] = {epoch_, i};
   }
   uint32_t groups = k;  // groups of searches still growing and not reported
   // Bricks each search takes per turn: one while the searches may still meet nearby (the
@@ -159,15 +157,17 @@ void BrickConnectivity::detached(std::span<const uint32_t> seeds, std::vector<st
       for (uint32_t taken = 0; taken < perTurn && heads_[i] < queues_[i].size() && groups > 1; ++taken) {
         const uint32_t u = queues_[i][heads_[i]++];
         ++st.visited;
+        // The queue's next lists, asked for ahead: a search walks a piece in a random order.
+        if (heads_[i] + kListsAhead < queues_[i].size()) adjacency_.prefetch(queues_[i][heads_[i] + kListsAhead]);
         for (uint32_t v : adjacency_[u]) {
-          if (stamp_[v] != epoch_) {
-            stamp_[v] = epoch_;
-            owner_[v] = i;
+          Mark& m = marks_[v];
+          if (m.stamp != epoch_) {
+            m = {epoch_, i};
             queues_[i].push_back(v);
             continue;
           }
-          if (owner_[v] == i) continue;  // this search's own brick (most edges)
-          const uint32_t a = find(i), b = find(owner_[v]);
+          if (m.owner == i) continue;  // this search's own brick (most edges)
+          const uint32_t a = find(i), b = find(m.owner);
           if (a == b) continue;
           parent_[std::max(a, b)] = std::min(a, b);  // the searches met: one part
           --groups;

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "collision/bricks/brick_grid.h"
+#include "collision/bricks/neighbour_lists.h"
 
 namespace bw {
 
@@ -74,12 +75,15 @@ class BrickConnectivity {
   void link(uint32_t a, uint32_t b);
   uint32_t find(uint32_t s);
 
-  std::vector<std::vector<uint32_t>> adjacency_;  // by brick id
-  std::vector<uint8_t> live_;                     // by brick id
+  NeighbourLists adjacency_;   // by brick id
+  std::vector<uint8_t> live_;  // by brick id
   std::vector<uint32_t> scratch_;
-  // detached(): per brick the search that reached it (valid while stamp == epoch), per search
-  // its queue and its union-find parent.
-  std::vector<uint32_t> stamp_, owner_;
+  // detached(): per brick the search that reached it (valid while stamp == epoch; one record,
+  // one cache miss per neighbour looked at), per search its queue and its union-find parent.
+  struct Mark {
+    uint32_t stamp = 0, owner = 0;
+  };
+  std::vector<Mark> marks_;
   uint32_t epoch_ = 0;
   std::vector<std::vector<uint32_t>> queues_;
   std::vector<uint32_t> heads_, parent_;

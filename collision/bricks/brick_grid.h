@@ -122,6 +122,30 @@ class BrickGrid {
   /// ids in order. Throws InvalidInput (a bad or repeated id, `into` not empty or this grid,
   /// other densities) or CapacityExceeded, moving nothing.
   std::vector<uint32_t> moveBricks(std::span<const uint32_t> ids, BrickGrid& into);
+
+  /// moveBricks in steps, for a caller that runs the two grids' halves at once on two threads
+  /// (they share nothing): prepareMove checks and gathers, changing nothing on error (it
+  /// throws as moveBricks does); then receiveMove on `into` (the index build) and releaseMove
+  /// on this grid (the bulk removal), in either order or at the same time, each once. The end
+  /// state is moveBricks'. Only an allocation failure can stop a step half way.
+  class Move {
+   public:
+    /// The bricks' ids in `into`, in the order of the ids moved (known once prepared).
+    const std::vector<uint32_t>& newIds() const { return newIds_; }
+
+   private:
+    friend class BrickGrid;
+    BrickGrid* from_ = nullptr;
+    BrickGrid* into_ = nullptr;
+    std::vector<uint32_t> ids_, newIds_, elements_;
+    std::vector<Brick> bricks_;
+    std::vector<Aabb> bounds_;
+  };
+  Move prepareMove(std::span<const uint32_t> ids, BrickGrid& into);
+  /// Called on the grid the bricks move into.
+  void receiveMove(Move& move);
+  /// Called on the grid the bricks leave.
+  void releaseMove(Move& move);
   /// Counts edits; caches keyed on it are stale when it changes.
   uint64_t editCount() const { return edits_; }
 
@@ -194,6 +218,8 @@ class BrickGrid {
   float roundingMargin(const Vec3f& queryPoint) const;
   /// placeBricks' work once the bricks are known to be valid and the grid empty.
   std::vector<uint32_t> placeValidBricks(const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
+  /// placeValidBricks with the bricks' ids allocated already (freed again if the build throws).
+  void fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
   void rebaseIfCancelling();
 };
 

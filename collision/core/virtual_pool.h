@@ -11,6 +11,7 @@
 /// policy. Thread safety: none; one writer at a time, readers only while no one writes.
 #include <cstdint>
 #include <new>
+#include <span>
 #include <string>
 #include <tuple>
 #include <type_traits>
@@ -54,6 +55,20 @@ class ParallelVirtualPool {
     if constexpr (!kTrivial) destroyAll(i, std::index_sequence_for<Ts...>{});
     space_.release(i);
   }
+
+  /// free() of each handle in turn (the same final state), for thousands at once: checked
+  /// first (InvalidInput naming a dead or repeated handle, nothing freed), slots asked for
+  /// ahead, and emptied pages given back in runs (PoolIndexSpace::releaseMany).
+  void freeMany(std::span<const uint32_t> handles) {
+    space_.requireLiveDistinct(handles, "freeMany");
+    if constexpr (!kTrivial)
+      for (uint32_t i : handles) destroyAll(i, std::index_sequence_for<Ts...>{});
+    space_.releaseMany(handles);
+  }
+  /// While alive, pages emptied by free() are given back in runs when it ends (a bulk edit
+  /// frees hundreds of blocks: a madvise and a TLB flush each otherwise).
+  using DeferPageRelease = PoolIndexSpace::DeferPageRelease;
+  DeferPageRelease deferPageRelease() { return DeferPageRelease(space_); }
 
   template <size_t K>
   Column<K>& get(uint32_t i) {

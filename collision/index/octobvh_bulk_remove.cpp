@@ -40,18 +40,26 @@ void OctoBvh::removeMany(std::span<const uint32_t> handles) {
   }
   std::vector<BuildItem>& items = buildScratch_;  // (no build runs during a bulk removal)
   items.resize(handles.size());
+  constexpr size_t kAhead = 16;  // the handles come in the caller's order: a miss each
   for (size_t i = 0; i < handles.size(); ++i) {
+    if (i + kAhead < handles.size()) prefetchElement(handles[i + kAhead]);
     const ElementRecord& r = elements_[handles[i]];
     centreOf(r, items[i].ctr);
     items[i].e = handles[i];
     items[i].minLevel = int8_t(minLevelOf(r));
   }
-  removing_ = marked.data();
-  removeManyAt(rootCluster_, 0, rootCube(), items.data(), uint32_t(items.size()));
-  removing_ = nullptr;
-  releaseBuildScratch();
-  for (uint32_t h : handles) elements_.free(h);
-  shrinkRoot();
+  {
+    // Whole subtrees go: their clusters' and blocks' emptied pages are given back in runs.
+    const auto deferClusters = clusters_.deferPageRelease();
+    const auto deferLeaves = leaves_.deferPageRelease();
+    const auto deferOverflow = overflow_.deferPageRelease();
+    removing_ = marked.data();
+    removeManyAt(rootCluster_, 0, rootCube(), items.data(), uint32_t(items.size()));
+    removing_ = nullptr;
+    releaseBuildScratch();
+    elements_.freeMany(handles);
+    shrinkRoot();
+  }
 }
 
 // Takes the k removed items (all in this node's subtree) out of node (c, s) of cube `cube`.

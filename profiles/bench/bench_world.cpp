@@ -2,10 +2,11 @@
 //
 //   build/release/bin/bench_world --benchmark_counters_tabular=true
 //
-// Split_CutInTwo/<bricks>: issue 18's cut: a static slab of cubes in two equal halves joined by
-//   one brick, split on; World::removeBricks of that brick, timed from the removal to the
-//   detached half's dynamic body made (connectivity search, its grid built in one pass, the
-//   bricks taken out of the old grid, the body added). Counters: parts, detached_bricks.
+// Split_CutInTwo/<bricks>/<threads>: issue 18's cut: a static slab of cubes in two equal halves
+//   joined by one brick, split on; World::removeBricks of that brick, timed from the removal to
+//   the detached half's dynamic body made (connectivity search, its grid built in one pass, the
+//   bricks taken out of the old grid, the body added), on a world of 1 or 2 threads (the build
+//   and the removal run at once on two). Counters: parts, detached_bricks.
 // Broadphase/<method>/<n>/iterations:<frames>/manual_time: issue 17's question, which
 // broadphase at 1k, 10k, 100k and 1M bodies. n moving 0.5 m boxes fall onto huge static grids
 // (400 x 400 x 40 m boxes, the shape of the shipped scenes), moved every frame (velocities flip
@@ -628,7 +629,7 @@ void Split_CutInTwo(benchmark::State& state) {
   scene.grids = {slab};
   uint32_t parts = 0, detached = 0;
   for (auto _ : state) {
-    World world(scene, 1);  // each cut needs the slab whole again (not timed)
+    World world(scene, int(state.range(1)));  // each cut needs the slab whole again (not timed)
     const uint32_t joint = uint32_t(slab.bricks.size() - 1);
     if (!world.grid(0).hasBrick(joint) || world.grid(0).brick(joint).position != slab.bricks.back().position) {
       state.SkipWithError("the joint's brick id is not the last one");
@@ -647,7 +648,11 @@ void Split_CutInTwo(benchmark::State& state) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::RegisterBenchmark("Split_CutInTwo", Split_CutInTwo)->Arg(100'000)->Iterations(5)->UseManualTime()->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("Split_CutInTwo", Split_CutInTwo)
+      ->ArgNames({"", "threads"})
+      ->Args({100'000, 1})
+      ->Args({100'000, 2})
+      ->Iterations(5)->UseManualTime()->Unit(benchmark::kMillisecond);
   // Broadphase rows: per method, every body count; the same frames (iterations) for every method.
   const auto add = [](const std::string& name, uint32_t n, void (*fn)(benchmark::State&)) {
     benchmark::RegisterBenchmark(name.c_str(), fn)->Arg(n)->Iterations(framesFor(n))->UseManualTime()->Unit(benchmark::kMillisecond);

@@ -17,6 +17,7 @@
 #include "world/edit_load.h"
 #include "world/scene_file.h"
 #include "world/world.h"
+#include "world/world_tuning.h"
 
 namespace bw {
 namespace {
@@ -406,6 +407,57 @@ TEST(EditLoadSplit, ADemolishedHouseSplitsTheSameForAnyThreadCount) {
       std::printf("[ demolition ] %u parts split off, %u debris bricks\n", splits, debris);
     } else {
       EXPECT_EQ(world.stateHash(), first) << threads << " threads";
+    }
+  }
+}
+
+// A cut into two big halves: from kParallelPartBricks bricks on, the part's grid is built on
+// one thread while the old grid lets go on another. Any thread count gives the same grids (ids,
+// index structure, mass) and the same state after the parts fall; mass is conserved.
+TEST(EditLoadSplit, ABigCutIsTheSameOnAnyThreadCountAndConservesMass) {
+  SceneDescription scene;
+  scene.name = "cut";
+  GridDescription slab;
+  slab.name = "slab";
+  slab.split = true;
+  const int side = 50;  // two halves of 2,500 bricks: above kParallelPartBricks
+  static_assert(50 * 50 >= tuning::kParallelPartBricks);
+  const Vec3f far(3000.f, -2000.f, 10.f);
+  for (int half = 0; half < 2; ++half)
+    for (int x = 0; x < side; ++x)
+      for (int y = 0; y < side; ++y)
+        slab.bricks.push_back(Brick::box(far + Vec3f(float(x + half * (side + 1)), float(y), float((x * 7 + y) % 3) * 0.25f),
+                                         Vec3f(0.5f, 0.5f, 0.5f + 0.125f * float((x + y) % 2))));
+  slab.bricks.push_back(Brick::box(far + Vec3f(float(side), float(side / 2), 0), Vec3f::Constant(0.5f)));  // the joint, last
+  scene.grids = {slab};
+  uint64_t firstHash = 0, firstTree[2] = {0, 0};
+  for (int threads : {1, 2, 4}) {
+    World world(scene, threads);
+    const MassProperties before = world.grid(0).massProperties();
+    const uint32_t joint = uint32_t(slab.bricks.size() - 1);
+    const MassProperties jointMass = [&] {
+      BrickGrid g;
+      g.placeBrick(world.grid(0).brick(joint));
+      return g.massProperties();
+    }();
+    const World::RemovalResult r = world.removeBricks(0, std::span<const uint32_t>(&joint, 1));
+    ASSERT_EQ(r.parts, 1u);
+    ASSERT_EQ(world.gridCount(), 2u);
+    EXPECT_EQ(world.grid(0).brickCount(), uint32_t(side * side));
+    EXPECT_EQ(world.grid(1).brickCount(), uint32_t(side * side));
+    world.grid(0).index().validate();
+    world.grid(1).index().validate();
+    const double mass = world.grid(0).massProperties().mass + world.grid(1).massProperties().mass;
+    EXPECT_NEAR(mass, before.mass - jointMass.mass, 1e-9 * before.mass);
+    for (int f = 0; f < 5; ++f) world.step();
+    if (threads == 1) {
+      firstHash = world.stateHash();
+      firstTree[0] = world.grid(0).index().structureHash();
+      firstTree[1] = world.grid(1).index().structureHash();
+    } else {
+      EXPECT_EQ(world.stateHash(), firstHash) << threads << " threads";
+      EXPECT_EQ(world.grid(0).index().structureHash(), firstTree[0]) << threads << " threads";
+      EXPECT_EQ(world.grid(1).index().structureHash(), firstTree[1]) << threads << " threads";
     }
   }
 }

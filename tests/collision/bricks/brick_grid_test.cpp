@@ -480,17 +480,20 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
     BrickGrid::Config config;
     config.density[2] = 3.f;
     const std::vector<Brick> bricks = randomBuild(23, 3000, offset);
-    for (int cut = 0; cut < 2; ++cut) {
+    // Cuts 0 and 1 by moveBricks; 2 and 3 the same cuts in steps, the old grid letting go
+    // before the new one is built (an order World may take on two threads).
+    for (int cut = 0; cut < 4; ++cut) {
+      const bool inSteps = cut >= 2;
       BrickGrid grid(config), twin(config);
       std::vector<uint32_t> ids;
       for (const Brick& b : bricks) {
         ids.push_back(grid.placeBrick(b));
         twin.placeBrick(b);
       }
-      SeededRandom r(uint64_t(31 + cut));
+      SeededRandom r(uint64_t(31 + cut % 2));
       std::vector<uint32_t> part;
       for (uint32_t id : ids)
-        if (cut ? grid.brick(id).position.x() < offset.x() + 20.f : r.unit() < 0.4) part.push_back(id);
+        if (cut % 2 ? grid.brick(id).position.x() < offset.x() + 20.f : r.unit() < 0.4) part.push_back(id);
       for (uint32_t i = uint32_t(part.size()); i > 1; --i) std::swap(part[i - 1], part[r.below(i)]);
       BrickGrid into(config);
       // Bad lists first: nothing may move.
@@ -502,7 +505,16 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
       EXPECT_THROW(grid.moveBricks(part, grid), InvalidInput);
       EXPECT_EQ(grid.brickCount(), bricks.size());
       EXPECT_EQ(into.brickCount(), 0u);
-      const std::vector<uint32_t> moved = grid.moveBricks(part, into);
+      std::vector<uint32_t> moved;
+      if (inSteps) {
+        BrickGrid::Move move = grid.prepareMove(part, into);
+        EXPECT_EQ(grid.brickCount(), bricks.size()) << "preparing changes nothing";
+        grid.releaseMove(move);
+        into.receiveMove(move);
+        moved = move.newIds();
+      } else {
+        moved = grid.moveBricks(part, into);
+      }
       ASSERT_EQ(moved.size(), part.size());
       std::vector<Brick> partBricks;
       for (uint32_t id : part) {

@@ -218,6 +218,81 @@ TEST(VirtualPool, OddSizedUnalignedElementsKeepTheirData) {
   differentialAgainstModel<1031>(10, 20'000);
 }
 
+// freeMany against free() one by one on a twin pool: the same slots handed out afterwards (the
+// free lists and released blocks in the same order), the same pages resident, every live
+// element's data intact; and the same under DeferPageRelease, whose pages go back at its end.
+template <size_t N>
+void freeManyEqualsFreeingOneByOne(uint64_t seed, uint32_t count) {
+  std::mt19937_64 rng(seed);
+  VirtualPool<Patterned<N>> one(count, "one"), many(count, "many"), deferred(count, "deferred");
+  std::vector<uint32_t> live;
+  for (int round = 0; round < 4; ++round) {
+    const uint32_t add = count / 2 - uint32_t(live.size()) / 2;
+    for (uint32_t i = 0; i < add && one.size() < count; ++i) {
+      const uint32_t a = one.allocate(), b = many.allocate(), c = deferred.allocate();
+      ASSERT_EQ(a, b);
+      ASSERT_EQ(a, c);
+      one[a].fill(a);
+      many[a].fill(a);
+      deferred[a].fill(a);
+      live.push_back(a);
+    }
+    // A random share (a contiguous run in one round: whole blocks), in a random order.
+    std::shuffle(live.begin(), live.end(), rng);
+    if (round == 2) std::sort(live.begin(), live.end());
+    const size_t k = round == 2 ? live.size() * 3 / 4 : size_t(rng() % live.size());
+    const std::vector<uint32_t> gone(live.begin(), live.begin() + long(k));
+    live.erase(live.begin(), live.begin() + long(k));
+    for (uint32_t h : gone) one.free(h);
+    many.freeMany(gone);
+    {
+      const auto defer = deferred.deferPageRelease();
+      for (uint32_t h : gone) deferred.free(h);
+    }
+    ASSERT_EQ(many.size(), one.size());
+    EXPECT_EQ(many.residentBytes(), one.residentBytes()) << "round " << round;
+    EXPECT_EQ(deferred.residentBytes(), one.residentBytes()) << "round " << round;
+    for (uint32_t h : live) {
+      ASSERT_TRUE(many.isLive(h));
+      ASSERT_TRUE(many[h].holds(h)) << "live data lost at " << h;
+      ASSERT_TRUE(deferred[h].holds(h)) << "live data lost at " << h;
+    }
+    for (uint32_t h : gone) ASSERT_FALSE(many.isLive(h));
+  }
+}
+
+TEST(VirtualPool, FreeManyLeavesWhatFreeingOneByOneLeaves) {
+  freeManyEqualsFreeingOneByOne<12>(21, 200'000);
+  freeManyEqualsFreeingOneByOne<40>(22, 100'000);  // blocks straddle pages
+  freeManyEqualsFreeingOneByOne<320>(23, 50'000);
+}
+
+TEST(VirtualPool, FreeManyRefusesADeadOrRepeatedHandleWhole) {
+  VirtualPool<Patterned<16>> pool(1000, "pool");
+  std::vector<uint32_t> ids;
+  for (int i = 0; i < 300; ++i) {
+    ids.push_back(pool.allocate());
+    pool[ids.back()].fill(ids.back());
+  }
+  pool.free(ids[7]);
+  const auto refused = [&](std::vector<uint32_t> handles, const char* what) {
+    try {
+      pool.freeMany(handles);
+      ADD_FAILURE() << "accepted";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(pool.size(), 299u) << "nothing freed";
+    for (uint32_t h : handles)
+      if (h != ids[7] && h < 1000) EXPECT_TRUE(pool.isLive(h) && pool[h].holds(h));
+  };
+  refused({ids[1], ids[2], ids[7], ids[3]}, "not a live element");
+  refused({ids[1], ids[2], ids[1]}, "listed twice");
+  refused({ids[4], 5000}, "not a live element");
+  pool.freeMany(std::vector<uint32_t>{ids[1], ids[2]});
+  EXPECT_EQ(pool.size(), 297u);
+}
+
 TEST(VirtualPool, RandomEditsMatchModel) {
   differentialAgainstModel<12>(1, 300'000);
   differentialAgainstModel<40>(2, 300'000);
