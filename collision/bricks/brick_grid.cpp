@@ -157,11 +157,8 @@ void BrickGrid::receiveMove(Move& m) {
 
 void BrickGrid::releaseMove(Move& m) {
   BW_ASSERT(m.from_ == this);
-  {
-    const auto defer = bricks_.deferPageRelease();
-    index_.removeMany(m.elements_);
-    bricks_.freeMany(m.ids_);
-  }
+  index_.removeMany(m.elements_);  // (both give emptied pages back in runs)
+  bricks_.freeMany(m.ids_);
   if (bricks_.size() == 0) {
     moments_.clear();
     peakSecond_ = 0;
