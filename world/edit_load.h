@@ -90,6 +90,7 @@ class EditLoad {
   std::vector<Stream> streams_;
   std::vector<LiveBricks> live_;   // by grid index (only edited grids fill theirs)
   std::vector<uint32_t> scratch_;  // overlap results
+  std::vector<uint32_t> picks_;    // a remove stream's bricks for this frame
   const Blocked* blocked_ = nullptr;  // during apply()
   const Hooks* hooks_ = nullptr;      // during apply()
   std::vector<std::pair<uint32_t, Aabb>> touched_;

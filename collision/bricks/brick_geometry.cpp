@@ -49,9 +49,9 @@ Eigen::Vector2d cylinderVertex(const Vec3f& h, int k, int n) {
 void validateBrick(const Brick& b, const char* context) {
   requireFinite(b.position, context, "brick.position");
   requireFinite(b.halfSize, context, "brick.halfSize");
-  for (int i = 0; i < 3; ++i)
-    requireInRange(b.halfSize[i], kMinBrickHalfSize, kMaxBrickHalfSize, context,
-                   (std::string("brick.halfSize.") + "xyz"[i]).c_str());
+  // note: names spelled out: building one per call allocated on every placement.
+  static const char* const kHalfSize[3] = {"brick.halfSize.x", "brick.halfSize.y", "brick.halfSize.z"};
+  for (int i = 0; i < 3; ++i) requireInRange(b.halfSize[i], kMinBrickHalfSize, kMaxBrickHalfSize, context, kHalfSize[i]);
   if (uint8_t(b.shape) > uint8_t(BrickShape::Cylinder))
     throw InvalidInput(std::string(context) + ": brick.shape is " + std::to_string(int(b.shape)) + ", expected 0..3");
   if (b.shape == BrickShape::Cylinder && (b.sides < 3 || b.sides > 64))

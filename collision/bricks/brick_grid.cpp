@@ -187,6 +187,22 @@ void BrickGrid::removeBrick(uint32_t id) {
   ++edits_;
 }
 
+void BrickGrid::prefetchRemovals(std::span<const uint32_t> ids) const {
+  uint32_t elements[kPrefetchGroup];
+  for (size_t first = 0; first < ids.size(); first += kPrefetchGroup) {
+    const std::span<const uint32_t> group = ids.subspan(first, std::min(kPrefetchGroup, ids.size() - first));
+    for (uint32_t id : group) {
+      if (!bricks_.isLive(id)) continue;
+      bricks_.prefetchFree(id);  // the brick itself: column 0
+      __builtin_prefetch(&bricks_.get<1>(id));
+    }
+    size_t n = 0;
+    for (uint32_t id : group)
+      if (bricks_.isLive(id)) elements[n++] = bricks_.get<1>(id);
+    index_.prefetchPaths({elements, n});
+  }
+}
+
 // note: the moments are summed about a reference point. When the bricks left are far from it
 // compared with their own spread (the bricks around it were removed), their inertia about the
 // centre of mass is the difference of two nearly equal numbers (the grid-edit fuzz target:

@@ -109,6 +109,12 @@ class BrickGrid {
   uint32_t placeBrick(const Brick& b);
   /// Removes a brick by id (InvalidInput for an unknown id).
   void removeBrick(uint32_t id);
+  /// Asks the cache for what removing these bricks will read: their records and their index
+  /// paths (OctoBvh::prefetchPaths). Read-only, so the removals after it leave what they would
+  /// have. For a loop about to remove many bricks one by one: call it on the next
+  /// kPrefetchGroup ids before removing them. Ids not in the grid are skipped.
+  void prefetchRemovals(std::span<const uint32_t> ids) const;
+  static constexpr size_t kPrefetchGroup = OctoBvh::kPrefetchGroup;
   /// Places many bricks into an empty grid at once (the index built in one pass: the same tree
   /// structure, ids and mass properties as placing them one by one, though its elements are
   /// numbered in another order, so queries may list the same bricks in another order); returns

@@ -67,6 +67,12 @@ class PoolIndexSpace {
   bool isLive(uint32_t index) const {
     return index < highWaterSlots() && (liveBits_[index >> 6] >> (index & 63)) & 1u;
   }
+  /// Asks the cache for what release(index) writes besides the slot: its live bits and its
+  /// block's record (index < highWaterSlots()).
+  void prefetchRelease(uint32_t index) const {
+    __builtin_prefetch(&liveBits_[index >> 6], 1);
+    __builtin_prefetch(&meta_[blockOf(index)], 1);
+  }
   std::byte* column(size_t k) const { return columns_[k]; }
   uint32_t size() const { return live_; }
   uint32_t capacity() const { return capacity_; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -20,6 +21,7 @@ constexpr size_t kKeptBuildItems = 32;
 constexpr uint32_t kClusterHeadroom = 1024;
 constexpr uint32_t kLeafHeadroom = 1024;
 constexpr int8_t kEmptyMinLevel = -128;
+constexpr float kInf = std::numeric_limits<float>::infinity();
 
 }  // namespace
 
@@ -233,15 +235,22 @@ void OctoBvh::clearNode(uint32_t c, int s) {
 
 bool OctoBvh::refit(uint32_t c, int s) {
   NodeCluster& cl = clusters_[c];
-  Aabb b = Aabb::empty();
+  // note: min levels grow with an element's largest extent, so the largest min level held is
+  // the one of the largest extent: one conversion per refit, not one per element. The merges
+  // are Aabb::merge's (std::min(acc, v)), on the record's floats.
+  float lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf}, largest = -1.f;
   uint32_t filter = 0;
-  int mml = kEmptyMinLevel;
   forEachHeld(cl, s, [&](uint32_t e) {
     const ElementRecord& r = elements_[e];
-    b.merge(r.bounds());
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], r.min[k]);
+      hi[k] = std::max(hi[k], r.max[k]);
+      largest = std::max(largest, r.max[k] - r.min[k]);
+    }
     filter |= r.filter;
-    mml = std::max(mml, minLevelOf(r));
   });
+  Aabb b{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+  int mml = largest < 0.f ? kEmptyMinLevel : minLevelForExtent(largest);
   cl.forEachSubCluster(s, [&](uint32_t sub) {
     // note: no emptiness test: an empty node's bounds are inverted, its filter 0 and its max
     // min level kEmptyMinLevel, so merging all 8 lanes is exact (and vectorises).

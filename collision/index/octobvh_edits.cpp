@@ -103,7 +103,8 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
   const uint32_t e = p.e;
   const ElementRecord& r = elements_[e];
   const int m = p.minLevel;
-  for (;;) {
+  const Lattice at = latticeOf(p.ctr);  // the walk's slots; the cube itself only where a build needs it
+  for (int level = cube.level;; --level) {
     NodeCluster& cl = clusters_[c];
     cl.minX[s] = std::min(cl.minX[s], r.min[0]);
     cl.minY[s] = std::min(cl.minY[s], r.min[1]);
@@ -114,7 +115,7 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
     cl.filter[s] |= r.filter;
     cl.maxMinLevel[s] = int8_t(std::max<int>(cl.maxMinLevel[s], m));
     if (cl.child[s] == kInvalidIndex) {
-      if (cl.numHeld[s] < kLeafCapacity || cube.level == kMinLevel) {
+      if (cl.numHeld[s] < kLeafCapacity || level == kMinLevel) {
         heldAdd(c, s, e);
         return;
       }
@@ -123,17 +124,17 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
       nine.reserve(9);
       heldTake(c, s, nine);
       nine.push_back(e);
-      buildFrom(c, s, cube, nine.data(), uint32_t(nine.size()));
+      buildFrom(c, s, cubeAt(at, level), nine.data(), uint32_t(nine.size()));
       return;
     }
     const uint32_t child = cl.child[s];
     prefetchForEdit(clusters_[child], true);
     uint32_t sub;  // the cluster e goes down into
-    if (m < cube.level) {
+    if (m < level) {
       if (clusters_[child].forcedCount > 0) {
         // The first element to fit a child under a node that forced everything it had: the
         // forced subtree moves whole to the node's forced cluster, and new children take e.
-        const uint32_t natural = allocCluster(cube.level - 1);
+        const uint32_t natural = allocCluster(level - 1);
         NodeCluster& n = clusters_[c];
         n.leaf[s] = child;
         n.numHeld[s] = kForcedCluster;
@@ -154,18 +155,18 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
       big.reserve(9);
       heldTake(c, s, big);
       big.push_back(e);
-      const uint32_t forced = allocCluster(cube.level - 1);
+      const uint32_t forced = allocCluster(level - 1);
       clusters_[c].leaf[s] = forced;
       clusters_[c].numHeld[s] = kForcedCluster;
-      for (uint32_t x : big) passDown(forced, cube, placementOf(x));  // counts childTotal only while forcedCount is 0
+      const Cube here = cubeAt(at, level);
+      for (uint32_t x : big) passDown(forced, here, placementOf(x));  // counts childTotal only while forcedCount is 0
       clusters_[forced].forcedCount = uint32_t(big.size());
       return;
     }
     NodeCluster& to = clusters_[sub];
     ++to.childTotal;
     if (to.forcedCount) ++to.forcedCount;
-    s = cube.childSlotFor(p.ctr);
-    cube = cube.child(s);
+    s = at.slotBelow(level);
     c = sub;
   }
 }
@@ -233,19 +234,18 @@ bool OctoBvh::updateInPlace(const Placement& old, const Placement& p, const Elem
   int depth = 0;
   uint32_t c = rootCluster_;
   int s = 0;
-  Cube cube = rootCube();
-  for (;;) {
+  const Lattice from = latticeOf(old.ctr), to = latticeOf(p.ctr);
+  for (int level = rootLevel_;; --level) {
     const NodeCluster& cl = clusters_[c];
     path[depth++] = {c, s};
     if (cl.child[s] == kInvalidIndex) break;  // a leaf: it holds the element
     prefetchForEdit(clusters_[cl.child[s]], false);
-    const uint32_t sub = clusterBelow(cl, s, cube.level, p.minLevel);
+    const uint32_t sub = clusterBelow(cl, s, level, p.minLevel);
     if (sub == kInvalidIndex) break;  // held at this inner node
-    const int o = cube.childSlotFor(old.ctr);
-    if (cube.childSlotFor(p.ctr) != o) return false;
+    const int o = from.slotBelow(level);
+    if (to.slotBelow(level) != o) return false;
     c = sub;
     s = o;
-    cube = cube.child(o);
   }
   elements_[p.e] = moved;
   while (depth > 0) {
@@ -310,8 +310,12 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
   Step path[kMaxLevel - kMinLevel + 2];  // every step goes down one level
   int depth = 0;
   const uint32_t e = p.e;
+  const Lattice at = latticeOf(p.ctr);
+  // Steps where the way back up may undo a forced split, by depth: their counts are final once
+  // the walk has passed them, so above the highest one the way up stops when nothing changed.
+  uint64_t undoSteps = 0;
   bool changed = true;  // whether the summary of the node the walk stopped at changed
-  for (;;) {
+  for (int level = cube.level;; --level) {
     NodeCluster& cl = clusters_[c];
     if (cl.child[s] == kInvalidIndex) {
       changed = heldRemoveChanges(c, s, p);
@@ -323,21 +327,26 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
       break;
     }
     // (Under a node that forced everything, more than 8 are left: else it merged above.)
-    const uint32_t sub = clusterBelow(cl, s, cube.level, p.minLevel);
+    const uint32_t sub = clusterBelow(cl, s, level, p.minLevel);
     if (sub == kInvalidIndex) {
       changed = heldRemoveChanges(c, s, p);
       break;
     }
-    path[depth++] = {c, s, sub == cl.child[s] ? kToChildren : kToForcedCluster};
+    const Way way = sub == cl.child[s] ? kToChildren : kToForcedCluster;
+    path[depth] = {c, s, way};
     NodeCluster& from = clusters_[sub];
     --from.childTotal;
     if (from.forcedCount) --from.forcedCount;
-    s = cube.childSlotFor(p.ctr);
-    cube = cube.child(s);
+    if (way == kToChildren ? cl.numHeld[s] == kForcedCluster && from.childTotal == 0
+                           : from.childTotal == uint32_t(kLeafCapacity))
+      undoSteps |= uint64_t(1) << depth;
+    ++depth;
+    s = at.slotBelow(level);
     c = sub;
   }
   if (changed) changed = refit(c, s);
   while (depth > 0) {
+    if (!changed && (undoSteps & ((uint64_t(1) << depth) - 1)) == 0) break;  // nothing left to do above
     const Step st = path[--depth];
     NodeCluster& cl = clusters_[st.c];
     const uint32_t child = cl.child[st.s], forced = cl.forced(st.s);
@@ -378,7 +387,7 @@ void OctoBvh::shrinkRoot() {
       return;
     }
     if (root.maxMinLevel[0] > R - 1) return;
-    const double half = std::ldexp(1.0, R - 1);
+    const double half = pow2(R - 1);
     bool fits = true;
     auto heldInside = [&](const NodeCluster& cl, int s) {
       forEachHeld(cl, s, [&](uint32_t e) {

@@ -7,9 +7,12 @@
 // LoadLighthouse/<Index> and LoadLighthouseTiled/<Index>: the same workload on the real save
 // ../shared/data/Lighthouse_Island.brs (25,427 bricks) and on it tiled 10 x 10 (2,542,700 bricks,
 // the article's build size), bricks in file order, tile by tile.
-// Edit/<Index>: insert, remove and update at 1M (ns per op). Overlap2m/<Index>, RayClosest200m/
-// <Index>, LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs
-// reversed child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again.
+// Edit/<Index>: insert, remove and update at 1M (ns per op); for OctoBVH also remove and update
+// by a loop that asks for each group of 32 edits' paths first (remove_prefetched_ns,
+// update_prefetched_ns: OctoBvh::prefetchPaths). Overlap2m/<Index>, RayClosest200m/<Index>,
+// LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs reversed
+// child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again; and another
+// 1000 moves with their paths asked for first (edits_1000_prefetched_ms).
 // The 1M rows run on the sparse build (`/sparse`) and on the dense one (`/dense`: the same bricks
 // packed 200x tighter, bw::kDenseBuild); Load rows take (bricks, dense 0/1).
 //
@@ -434,6 +437,37 @@ void editsWith(benchmark::State& state, const char* name, bool dense) {
     }
     const double updateNs = secondsSince(t) * 1e9 / kOps;
     for (uint32_t i = 0; i < kOps; ++i) index.update(handles[i], b[payload[i]], 1);
+    if constexpr (requires { index.prefetchPaths(std::span<const uint32_t>{}); }) {
+      // The same kinds of edit on another kOps bricks, in the same sequence, by a loop that asks
+      // for each group's paths first (OctoBvh::prefetchPaths).
+      auto prefetched = [&](auto&& edit) {
+        const auto t0 = Clock::now();
+        for (uint32_t i = 0; i < kOps; ++i) {
+          if (i % Index::kPrefetchGroup == 0)
+            index.prefetchPaths(std::span(handles).subspan(i, std::min<size_t>(Index::kPrefetchGroup, kOps - i)));
+          edit(i);
+        }
+        return secondsSince(t0) * 1e9 / kOps;
+      };
+      handles.clear();
+      for (uint32_t i = 0; i < kOps; ++i) {
+        uint32_t h;
+        do h = r.below(kMillion);
+        while (!index.contains(h) || std::find(handles.begin(), handles.end(), h) != handles.end());
+        handles.push_back(h);
+        payload[i] = index.payload(h);
+      }
+      const double pRemove = prefetched([&](uint32_t i) { index.remove(handles[i]); });
+      for (uint32_t i = 0; i < kOps; ++i) handles[i] = index.insert(b[payload[i]], 1, payload[i]);
+      const double pUpdate = prefetched([&](uint32_t i) {
+        const Aabb& o = b[payload[i]];
+        index.update(handles[i], {o.min + Vec3f(0.2f, 0, 0), o.max + Vec3f(0.2f, 0, 0)}, 1);
+      });
+      for (uint32_t i = 0; i < kOps; ++i) index.update(handles[i], b[payload[i]], 1);
+      state.counters["remove_prefetched_ns"] = pRemove;
+      state.counters["update_prefetched_ns"] = pUpdate;
+      summary()[std::string("remove_prefetched_ns_") + name + buildKey(dense)] = pRemove;
+    }
     state.counters["insert_ns"] = insertNs;
     state.counters["remove_ns"] = removeNs;
     state.counters["update_ns"] = updateNs;
@@ -636,7 +670,25 @@ void EditsThenRays_OctoBVH(benchmark::State& state, bool dense) {
     const double editMs = secondsSince(t) * 1e3;
     const double after = rays();
     for (uint32_t h : moved) index.update(h, b[index.payload(h)], 1);
+    // Another 1000 moves, after the rays again, by a loop that knows them ahead (prefetchPaths
+    // on each group of them).
+    rays();
+    std::vector<uint32_t> next;
+    for (int k = 0; k < 1000; ++k) {
+      const uint32_t h = r.below(kMillion);
+      if (index.contains(h) && std::find(next.begin(), next.end(), h) == next.end()) next.push_back(h);
+    }
+    const auto tp = Clock::now();
+    for (size_t k = 0; k < next.size(); ++k) {
+      if (k % bw::OctoBvh::kPrefetchGroup == 0)
+        index.prefetchPaths(std::span(next).subspan(k, std::min(bw::OctoBvh::kPrefetchGroup, next.size() - k)));
+      const Aabb& o = b[index.payload(next[k])];
+      index.update(next[k], {o.min + Vec3f(0, 0.4f, 0), o.max + Vec3f(0, 0.4f, 0)}, 1);
+    }
+    const double prefetchedMs = secondsSince(tp) * 1e3 * 1000.0 / double(std::max<size_t>(next.size(), 1));
+    for (uint32_t h : next) index.update(h, b[index.payload(h)], 1);
     state.counters["edits_1000_ms"] = editMs;
+    state.counters["edits_1000_prefetched_ms"] = prefetchedMs;
     state.counters["ray_ns_before"] = before;
     state.counters["ray_ns_after"] = after;
   }

@@ -415,6 +415,57 @@ TEST(OctoBvh, RemoveManyLeavesWhatOneByOneRemovalsLeave) {
   }
 }
 
+// prefetchPaths walks a group's paths in lockstep ahead of their edits: every walk must end at
+// the node holding its element (giants held at inner nodes, forced clusters, overflowing leaves
+// included), dead handles are skipped, and nothing changes: removals after it leave what a twin
+// removing without it leaves.
+TEST(OctoBvh, PrefetchedPathsEndAtEachHolderAndChangeNothing) {
+  for (const Vec3f& offset : {Vec3f(0, 0, 0), Vec3f(-3e5f, 7e5f, 2e5f)}) {
+    SeededRandom r(offset.x() == 0 ? 91 : 92);
+    const std::vector<Aabb> boxes = mixedWorkload(4000, 11, offset);
+    OctoBvh tree, twin;
+    test::BruteForceIndex ref, twinRef;
+    std::vector<uint32_t> live = insertMirrored(tree, ref, boxes);
+    insertMirrored(twin, twinRef, boxes);
+    ASSERT_GT(tree.shapeStats().forcedElements, 0u);
+    for (uint32_t i = uint32_t(live.size()); i > 1; --i) std::swap(live[i - 1], live[r.below(i)]);
+    std::vector<uint32_t> dead;
+    for (size_t first = 0; first < live.size(); first += OctoBvh::kPrefetchGroup) {
+      const size_t n = std::min(OctoBvh::kPrefetchGroup, live.size() - first);
+      std::vector<uint32_t> group(live.begin() + first, live.begin() + first + n);
+      const uint64_t before = tree.structureHash();
+      ASSERT_EQ(tree.prefetchPaths(group), n) << "group at " << first;
+      // Dead and never-used handles mixed in are skipped; longer lists go group by group.
+      std::vector<uint32_t> mixed = group;
+      mixed.insert(mixed.end(), dead.begin(), dead.begin() + std::min<size_t>(dead.size(), 5));
+      mixed.push_back(0xFFFFFFF0u);
+      mixed.insert(mixed.end(), group.begin(), group.end());
+      ASSERT_EQ(tree.prefetchPaths(mixed), 2 * n);
+      ASSERT_EQ(tree.structureHash(), before);
+      // Half of each group removed, the rest moved a little (in place or along a new path).
+      for (uint32_t h : group) {
+        if (r.unit() < 0.5) {
+          tree.remove(h);
+          twin.remove(h);
+          dead.push_back(h);
+        } else {
+          const Aabb b = tree.bounds(h);
+          const Vec3f step(float(r.uniform(-0.3, 0.3)), 0.f, float(r.uniform(-2.0, 2.0)));
+          tree.update(h, {b.min + step, b.max + step}, tree.filter(h));
+          twin.update(h, {b.min + step, b.max + step}, twin.filter(h));
+        }
+      }
+      if (first % (8 * OctoBvh::kPrefetchGroup) == 0) {
+        tree.validate();
+        ASSERT_EQ(tree.structureHash(), twin.structureHash()) << "group at " << first;
+      }
+    }
+    tree.validate();
+    EXPECT_EQ(tree.structureHash(), twin.structureHash());
+    EXPECT_EQ(tree.prefetchPaths(dead), 0u);
+  }
+}
+
 // Giants among small bricks sit in forced clusters: removing all but a few giants must hold them
 // at their node again, and removing every small brick under them must turn the forced cluster
 // back into the children, as single removals do.
