@@ -85,8 +85,11 @@ bool EditLoad::isFree(uint32_t gridIndex, const BrickGrid& grid, const Brick& b)
   // Shrunk a little: a brick may touch its neighbours face to face, not overlap them.
   const Aabb box = brickBounds(b);
   const Vec3f inset = box.halfExtent() * 0.02f;
+  const Aabb shrunk{box.min + inset, box.max - inset};
+  for (const Brick& p : pending_)  // chosen in this group, not placed yet
+    if (shrunk.overlaps(brickBounds(p))) return false;
   scratch_.clear();
-  grid.overlapBricks(Aabb{box.min + inset, box.max - inset}, ~0u, scratch_);
+  grid.overlapBricks(shrunk, ~0u, scratch_);
   return scratch_.empty() && !(blocked_ && *blocked_ && (*blocked_)(gridIndex, box));
 }
 
@@ -127,7 +130,13 @@ void EditLoad::remove(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStat
   }
 }
 
+// note: spots are chosen a group at a time and the group placed together, its index paths
+// asked for first: a new brick goes where nothing is yet, so the overlap query that found the
+// spot stopped above the nodes the insert walks through, and a lone insert waits on their
+// misses one after another. A spot is free of the grid and of the group's earlier choices;
+// sources are the grid's live bricks (a group's bricks join them once placed).
 void EditLoad::place(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st) {
+  pending_.clear();
   for (uint32_t k = 0; k < s.d.perFrame; ++k) {
     bool done = false;
     // A few source bricks, each tried on top first, then beside it, where nothing is yet.
@@ -139,12 +148,22 @@ void EditLoad::place(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats
         Brick b = from;
         b.position += offsets[t];
         if (!isFree(s.grid, grid, b)) continue;
-        live.add(timedPlace(s.grid, grid, b, st));
+        pending_.push_back(b);
         done = true;
       }
     }
     st.skipped += done ? 0 : 1;
+    if (pending_.size() == BrickGrid::kPrefetchGroup) placePending(s.grid, grid, live, st);
   }
+  placePending(s.grid, grid, live, st);
+}
+
+void EditLoad::placePending(uint32_t gridIndex, BrickGrid& grid, LiveBricks& live, EditLoadStats& st) {
+  const auto t = std::chrono::steady_clock::now();
+  grid.prefetchPlacements(pending_);
+  st.gridEditMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  for (const Brick& b : pending_) live.add(timedPlace(gridIndex, grid, b, st));
+  pending_.clear();
 }
 
 void EditLoad::carve(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st) {
@@ -197,6 +216,7 @@ EditLoadStats EditLoad::apply(uint64_t frame, const std::vector<std::unique_ptr<
                               const Blocked& blocked, const Hooks& hooks) {
   EditLoadStats st;
   touched_.clear();
+  pending_.clear();
   blocked_ = &blocked;
   hooks_ = &hooks;
   struct Reset {

@@ -86,11 +86,14 @@ class EditLoad {
   // The grid edits themselves, timed into stats.gridEditMs.
   uint32_t timedPlace(uint32_t gridIndex, BrickGrid& grid, const Brick& b, EditLoadStats& st);
   void timedRemove(uint32_t gridIndex, BrickGrid& grid, uint32_t id, EditLoadStats& st);
+  /// Places pending_ (its index paths asked for first) and empties it.
+  void placePending(uint32_t gridIndex, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
 
   std::vector<Stream> streams_;
   std::vector<LiveBricks> live_;   // by grid index (only edited grids fill theirs)
   std::vector<uint32_t> scratch_;  // overlap results
   std::vector<uint32_t> picks_;    // a remove stream's bricks for this frame
+  std::vector<Brick> pending_;     // a place stream's group of chosen spots, not placed yet
   const Blocked* blocked_ = nullptr;  // during apply()
   const Hooks* hooks_ = nullptr;      // during apply()
   std::vector<std::pair<uint32_t, Aabb>> touched_;

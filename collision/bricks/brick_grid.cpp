@@ -203,6 +203,23 @@ void BrickGrid::prefetchRemovals(std::span<const uint32_t> ids) const {
   }
 }
 
+void BrickGrid::prefetchPlacements(std::span<const Brick> bricks) const {
+  Aabb bounds[kPrefetchGroup];
+  for (size_t first = 0; first < bricks.size(); first += kPrefetchGroup) {
+    const std::span<const Brick> group = bricks.subspan(first, std::min(kPrefetchGroup, bricks.size() - first));
+    size_t n = 0;
+    for (const Brick& b : group) {
+      try {
+        validateBrick(b, "BrickGrid::prefetchPlacements");  // (placeBrick reports a bad brick)
+      } catch (const InvalidInput&) {
+        continue;
+      }
+      bounds[n++] = brickBounds(b);
+    }
+    index_.prefetchInsertPaths({bounds, n});
+  }
+}
+
 // note: the moments are summed about a reference point. When the bricks left are far from it
 // compared with their own spread (the bricks around it were removed), their inertia about the
 // centre of mass is the difference of two nearly equal numbers (the grid-edit fuzz target:

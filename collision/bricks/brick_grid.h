@@ -114,6 +114,9 @@ class BrickGrid {
   /// have. For a loop about to remove many bricks one by one: call it on the next
   /// kPrefetchGroup ids before removing them. Ids not in the grid are skipped.
   void prefetchRemovals(std::span<const uint32_t> ids) const;
+  /// The same for placing these bricks: the index paths their bounds will take
+  /// (OctoBvh::prefetchInsertPaths). Bricks that are not valid are skipped.
+  void prefetchPlacements(std::span<const Brick> bricks) const;
   static constexpr size_t kPrefetchGroup = OctoBvh::kPrefetchGroup;
   /// Places many bricks into an empty grid at once (the index built in one pass: the same tree
   /// structure, ids and mass properties as placing them one by one, though its elements are

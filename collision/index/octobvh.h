@@ -115,6 +115,10 @@ class OctoBvh {
   /// than that may be evicted before use). Dead handles are skipped. Returns how many walks
   /// found their element at the node they ended at: every live handle's (a check for tests).
   size_t prefetchPaths(std::span<const uint32_t> handles) const;
+  /// The same for inserting elements of these bounds: the clusters on the paths they will take
+  /// and the lists at their ends (a leaf that splits reads every record on it). Boxes that are
+  /// not valid elements, or would grow the root, are skipped.
+  void prefetchInsertPaths(std::span<const Aabb> bounds) const;
   static constexpr size_t kPrefetchGroup = 32;
   /// Tight bounds of everything (empty box when the tree is empty).
   Aabb rootBounds() const { return clusters_[rootCluster_].bounds(0); }
@@ -233,6 +237,15 @@ class OctoBvh {
     cube.level = level;
     return cube;
   }
+  /// A prefetch walk (octobvh_prefetch.cpp): where it is, where it goes, whose path it is.
+  struct PathWalk {
+    Lattice at;
+    uint32_t c;
+    int s;
+    int minLevel;
+    uint32_t e;  ///< the element, or kInvalidIndex for an insert's path
+  };
+  size_t prefetchWalks(PathWalk* walks, size_t count) const;
   /// An element and where it goes, computed once per edit rather than at every level.
   struct Placement {
     uint32_t e;

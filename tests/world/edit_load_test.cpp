@@ -116,6 +116,28 @@ TEST(EditLoad, PlacementsLandBesideTheirSourceAndNeverOverlapABrick) {
   EXPECT_GT(placed, 400u);
 }
 
+// Spots are chosen a group at a time and placed together: a spot chosen earlier in the group
+// is taken. Around one brick alone there are five spots (on top, four sides), so a group of 32
+// fills exactly those five, and the next groups build from the bricks placed before them.
+TEST(EditLoad, PlacementsChosenTogetherNeverTakeTheSameSpot) {
+  std::vector<std::unique_ptr<BrickGrid>> grids;
+  grids.push_back(std::make_unique<BrickGrid>(BrickGrid::Config(1024)));
+  grids[0]->placeBrick(Brick::box(Vec3f(-700.f, 30.f, 2.f), Vec3f(0.5f, 0.25f, 0.2f)));
+  EditLoad load({stream(EditLoadDescription::Kind::Place, uint32_t(BrickGrid::kPrefetchGroup), 8)}, {0});
+  std::vector<uint32_t> edited;
+  EditLoadStats s = load.apply(0, grids, edited);
+  EXPECT_EQ(s.placed, 5u);
+  EXPECT_EQ(s.skipped, BrickGrid::kPrefetchGroup - 5);
+  for (uint64_t f = 1; f < 4; ++f) {
+    s = load.apply(f, grids, edited);
+    EXPECT_GT(s.placed, 5u) << "frame " << f;
+  }
+  const auto all = liveBricks(*grids[0]);
+  for (const auto& [id, brick] : all)
+    for (const auto& [other, o] : all)
+      if (other > id) ASSERT_FALSE(overlaps(brick, o)) << "bricks " << id << " and " << other;
+}
+
 TEST(EditLoad, CarvedHolesAreExactlyTheBricksWithinTheRadiusOfOneBrick) {
   std::vector<std::unique_ptr<BrickGrid>> grids;
   grids.push_back(seededGrid(8));
