@@ -276,14 +276,24 @@ void World::applyGridEdits() {
   // The world boxes of the edit load's bricks, on every body holding their grid.
   std::vector<WorldAabb> boxes;
   std::vector<uint32_t> owners;
+  // note: each holder's pose and rotation taken once per run of bricks on its grid, not per brick.
+  std::vector<std::pair<RigidTransform, Mat3f>> holders;
+  uint32_t holdersOf = kInvalidIndex;
   for (const auto& [grid, local] : editLoad_.touched()) {
     if (edited[grid] != 1) continue;
-    for (uint32_t i : gridBodies_[grid]) {
-      const RigidTransform pose = bodies_.shapePose(i);
-      const Vec3d centre = pose.pointToWorld(local.center());
-      const Vec3d half = (pose.rotation.toRotationMatrix().cwiseAbs() * local.halfExtent()).cast<double>();
+    if (grid != holdersOf) {
+      holders.clear();
+      for (uint32_t i : gridBodies_[grid]) {
+        const RigidTransform pose = bodies_.shapePose(i);
+        holders.emplace_back(pose, pose.rotation.toRotationMatrix().cwiseAbs());
+      }
+      holdersOf = grid;
+    }
+    for (size_t h = 0; h < holders.size(); ++h) {
+      const Vec3d centre = holders[h].first.pointToWorld(local.center());
+      const Vec3d half = (holders[h].second * local.halfExtent()).cast<double>();
       boxes.push_back({centre - half, centre + half});
-      owners.push_back(i);
+      owners.push_back(gridBodies_[grid][h]);
     }
   }
   editedBoxes_.build(std::move(boxes), std::move(owners));
@@ -293,7 +303,8 @@ void World::applyGridEdits() {
       if (!bodies_.shape[g].isGrid() || !edited[bodies_.shape[g].grid]) continue;
       if (edited[bodies_.shape[g].grid] == 2) return true;
       float reach;
-      if (editedBoxes_.any(boundsOf(other, reach), [&](uint32_t holder) { return holder == g; })) return true;
+      const WorldAabb box = other < hasEditBounds_.size() && hasEditBounds_[other] ? editBounds_[other] : boundsOf(other, reach);
+      if (editedBoxes_.any(box, [&](uint32_t holder) { return holder == g; })) return true;
     }
     return false;
   };
@@ -456,11 +467,16 @@ EditLoad::Blocked World::editBlockers() {
   // tested where each body holding its grid holds it.
   std::vector<WorldAabb> boxes;
   std::vector<uint32_t> owners;
+  editBounds_.resize(bodies_.size());
+  hasEditBounds_.assign(bodies_.size(), 0);
   for (uint32_t i = 0; i < bodies_.size(); ++i) {
     if (bodies_.motion[i] != MotionType::Dynamic) continue;
     float reach;
     boxes.push_back(boundsOf(i, reach));
     owners.push_back(i);
+    if (bodies_.shape[i].isGrid() || bodies_.shape[i].isTerrain()) continue;
+    editBounds_[i] = boxes.back();
+    hasEditBounds_[i] = 1;
   }
   editBodies_.build(std::move(boxes), std::move(owners));
   return [this](uint32_t grid, const Aabb& local) {
@@ -521,6 +537,7 @@ void World::runEdits() {
   const bool edited = !editedGrids_.empty();
   applyGridEdits();
   if (edited) stats_.editMs += msSince(apply);
+  hasEditBounds_.clear();  // the boxes are this frame's only
 }
 
 void World::applyFrameEdits() {

@@ -406,6 +406,11 @@ class World {
   std::vector<uint32_t> debrisBricks_;
   uint32_t piecesMade_ = 0;
   BodyBoxIndex editBodies_;            // dynamic bodies' boxes, built when the edit load places bricks
+  // Per body, the box editBlockers() took for it this frame, kept for the primitives only
+  // (hasEditBounds_): edits between steps move no primitive, so applyGridEdits() reads the same
+  // box again rather than computing it twice.
+  std::vector<WorldAabb> editBounds_;
+  std::vector<uint8_t> hasEditBounds_;
   // Terrains that break (TerrainDescription::breakFree), per terrain; the scene's carves.
   struct TerrainBreak {
     bool breakFree;

@@ -14,9 +14,11 @@ namespace {
 
 TEST(BodyBoxIndex, VisitsWhatBruteForceFindsAndAnswersAnyAlike) {
   SeededRandom r(41);
-  for (int round = 0; round < 6; ++round) {
+  // Rounds 6 and 7: every box starting at one x (one bucket), and one box 1e6 beyond the rest
+  // (the others crowd into the first bucket).
+  for (int round = 0; round < 8; ++round) {
     const Vec3d origin = round % 2 ? Vec3d(3e6, -2e6, 5e5) : Vec3d::Zero();
-    const uint32_t n = round == 0 ? 0 : (round == 1 ? 1 : 200 * uint32_t(round));
+    const uint32_t n = round == 0 ? 0 : (round == 1 ? 1 : 200 * uint32_t(round % 6 + 1));
     std::vector<WorldAabb> boxes;
     std::vector<uint32_t> bodies;
     for (uint32_t i = 0; i < n; ++i) {
@@ -25,6 +27,11 @@ TEST(BodyBoxIndex, VisitsWhatBruteForceFindsAndAnswersAnyAlike) {
       if (i % 7 == 0) h.x() = 0.1;  // thin along x
       WorldAabb b{c - h, c + h};
       if (i % 11 == 0 && !boxes.empty()) b.min.x() = boxes.back().min.x();  // equal min x
+      if (round == 6) {
+        b.min.x() = origin.x() - 1;
+        b.max.x() = std::max(b.max.x(), b.min.x());
+      }
+      if (round == 7 && i == n / 2) b = {c + Vec3d(1e6, 0, 0), c + Vec3d(1e6 + 1, 1, 1)};
       boxes.push_back(b);
       bodies.push_back(r.below(n / 2 + 1));  // bodies own several boxes
     }
