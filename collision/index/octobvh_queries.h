@@ -147,7 +147,9 @@ void OctoBvh::walkOverlap(const Aabb& outer, uint32_t mask, QueryStats* stats, O
           hits &= hits - 1;
           if (!accept(c, o)) continue;
           stack[sp++] = nodeRef(c, o);
+          // note: the node's children and what it holds are what its visit reads first.
           if (ch.child[o] != kInvalidIndex) prefetchBounds(clusters_[ch.child[o]]);
+          prefetchHeld(ch, o);
         }
       });
     }
@@ -378,8 +380,9 @@ void traverseRay(const Tree& tree, const Ray& ray, uint32_t mask, const std::arr
         const int o = order[k];
         if (!(hits >> o & 1u)) continue;
         stack[sp++] = {nodeRef(c, o), tc[o]};
-        // note: the node's children are what its visit reads first; fetch their bounds now.
+        // note: the node's children and what it holds are what its visit reads first; fetch them now.
         if (ch.child[o] != kInvalidIndex) prefetchBounds(tree.cluster(ch.child[o]));
+        tree.prefetchHeld(ch, o);
       }
     };
     if (cl.child[s] == kInvalidIndex) continue;
