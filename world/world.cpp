@@ -515,6 +515,7 @@ void World::refreshGridBodyMass(uint32_t body) {
 
 void World::runEdits() {
   ProfileZone z(profiler_, "edits", kEditStage, true);
+  hasEditBounds_.clear();  // boxes are kept for one frame's edits only (editBlockers() takes them)
   editLog_.clear();
   if (recordingEdits_) {  // what removeBricks() and editGrid() did since the last step comes first
     std::swap(editLog_, betweenSteps_);
@@ -537,7 +538,6 @@ void World::runEdits() {
   const bool edited = !editedGrids_.empty();
   applyGridEdits();
   if (edited) stats_.editMs += msSince(apply);
-  hasEditBounds_.clear();  // the boxes are this frame's only
 }
 
 void World::applyFrameEdits() {
