@@ -7,7 +7,7 @@
 namespace bw {
 
 int BoxOccupancyBits::cellOf(double v, int axis) const {
-  const double t = (v - low_[axis]) * scale_[axis];
+  const double t = (v - bounds_.min[axis]) * scale_[axis];
   // note: compared as doubles first: a box far outside the built bounds (a query) must not
   // overflow the conversion.
   return t <= 0.0 ? 0 : t >= double(kCells - 1) ? kCells - 1 : int(t);
@@ -40,7 +40,6 @@ void BoxOccupancyBits::build(const std::vector<WorldAabb>& boxes) {
     return;
   }
   for (int k = 0; k < 3; ++k) {
-    low_[k] = lo[k];
     scale_[k] = hi[k] > lo[k] ? double(kCells) / (hi[k] - lo[k]) : 0.0;
     // A span beyond double's reach leaves the filter off rather than guessing.
     if (!std::isfinite(scale_[k])) off_ = true;

@@ -36,8 +36,8 @@ class BoxOccupancyBits {
   int cellOf(double v, int axis) const;
 
   std::vector<uint64_t> rows_;  // rows_[z * kCells + y], bit x
-  WorldAabb bounds_{};  // of all boxes built from
-  std::array<double, 3> low_{}, scale_{};
+  WorldAabb bounds_{};  // of all boxes built from; cells start at its min corner
+  std::array<double, 3> scale_{};
   bool empty_ = true, off_ = false;
 };
 

@@ -277,22 +277,13 @@ void World::applyGridEdits() {
   std::vector<WorldAabb> boxes;
   std::vector<uint32_t> owners;
   // note: each holder's pose and rotation taken once per run of bricks on its grid, not per brick.
-  std::vector<std::pair<RigidTransform, Mat3f>> holders;
+  std::vector<PoseBoxes> holders;
   uint32_t holdersOf = kInvalidIndex;
   for (const auto& [grid, local] : editLoad_.touched()) {
     if (edited[grid] != 1) continue;
-    if (grid != holdersOf) {
-      holders.clear();
-      for (uint32_t i : gridBodies_[grid]) {
-        const RigidTransform pose = bodies_.shapePose(i);
-        holders.emplace_back(pose, pose.rotation.toRotationMatrix().cwiseAbs());
-      }
-      holdersOf = grid;
-    }
+    if (grid != holdersOf) holderPoses(holdersOf = grid, holders);
     for (size_t h = 0; h < holders.size(); ++h) {
-      const Vec3d centre = holders[h].first.pointToWorld(local.center());
-      const Vec3d half = (holders[h].second * local.halfExtent()).cast<double>();
-      boxes.push_back({centre - half, centre + half});
+      boxes.push_back(holders[h].worldBox(local));
       owners.push_back(gridBodies_[grid][h]);
     }
   }
@@ -479,15 +470,12 @@ EditLoad::Blocked World::editBlockers() {
     hasEditBounds_[i] = 1;
   }
   editBodies_.build(std::move(boxes), std::move(owners));
-  return [this](uint32_t grid, const Aabb& local) {
-    for (uint32_t holder : gridBodies_[grid]) {
-      const RigidTransform pose = bodies_.shapePose(holder);
-      const Vec3d centre = pose.pointToWorld(local.center());
-      const Vec3d half = (pose.rotation.toRotationMatrix().cwiseAbs() * local.halfExtent()).cast<double>();
-      const WorldAabb box{centre - half, centre + half};
-      const auto other = [&](uint32_t body) { return !(bodies_.shape[body].isGrid() && bodies_.shape[body].grid == grid); };
-      if (editBodies_.any(box, other)) return true;
-    }
+  // note: the holders' poses taken once per grid asked about, not once per planned brick.
+  return [this, holders = std::vector<PoseBoxes>(), holdersOf = kInvalidIndex](uint32_t grid, const Aabb& local) mutable {
+    if (grid != holdersOf) holderPoses(holdersOf = grid, holders);
+    const auto other = [&](uint32_t body) { return !(bodies_.shape[body].isGrid() && bodies_.shape[body].grid == grid); };
+    for (const PoseBoxes& holder : holders)
+      if (editBodies_.any(holder.worldBox(local), other)) return true;
     return false;
   };
 }
@@ -511,6 +499,11 @@ void World::refreshGridBodyMass(uint32_t body) {
   bodies_.inverseMass[body] = frame.inverseMass;
   bodies_.inverseInertia[body] = frame.inverseInertia;
   sleep_.wake(body);
+}
+
+void World::holderPoses(uint32_t grid, std::vector<PoseBoxes>& out) const {
+  out.clear();
+  for (uint32_t i : gridBodies_[grid]) out.emplace_back(bodies_.shapePose(i));
 }
 
 void World::runEdits() {

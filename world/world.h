@@ -46,6 +46,7 @@
 #include "world/edit_log.h"
 #include "world/islands.h"
 #include "world/pair_cache.h"
+#include "world/pose_boxes.h"
 #include "world/ray_load.h"
 #include "world/scene_description.h"
 #include "world/sleeping.h"
@@ -293,6 +294,8 @@ class World {
   void substep(float dt, int index);
   void integrate(float dt, int stage);
   void applyGridEdits();
+  /// The poses of the bodies holding grid, in gridBodies_ order (the edits move none of them).
+  void holderPoses(uint32_t grid, std::vector<PoseBoxes>& out) const;
   /// What the edit load must not build into: the dynamic bodies (none if it places nothing).
   EditLoad::Blocked editBlockers();
   /// Split grids edited through editGrid() get their connectivity taken again.
