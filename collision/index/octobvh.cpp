@@ -318,15 +318,30 @@ void OctoBvh::freeSubtreeClusters(uint32_t cluster) {
 void OctoBvh::buildFrom(uint32_t c, int s, const Cube& cube, const uint32_t* elems, uint32_t count) {
   std::vector<BuildItem>& items = buildScratch_;
   items.resize(count);
-  for (uint32_t i = 0; i < count; ++i) {
-    const ElementRecord& r = elements_[elems[i]];
-    BuildItem& it = items[i];
-    centreOf(r, it.ctr);
-    it.e = elems[i];
-    it.minLevel = int8_t(minLevelOf(r));
-  }
+  for (uint32_t i = 0; i < count; ++i) buildItemOf(elements_[elems[i]], elems[i], items[i]);
   build(c, s, cube, items.data(), count);
   releaseBuildScratch();
+}
+
+void OctoBvh::buildItemOf(const ElementRecord& r, uint32_t e, BuildItem& it) {
+  centreOf(r, it.ctr);
+  it.e = e;
+  it.minLevel = int8_t(minLevelOf(r));
+}
+
+uint32_t OctoBvh::placeBuilt(uint32_t e) {
+  if (!bulk_) return e;
+  const uint32_t h = elements_.allocate();
+  ElementRecord& r = elements_[h];
+  const Aabb& b = bulk_->bounds[e];
+  for (int k = 0; k < 3; ++k) {
+    r.min[k] = b.min[k];
+    r.max[k] = b.max[k];
+  }
+  r.filter = bulk_->filters[e];
+  r.payload = bulk_->payloads[e];
+  bulk_->handles[e] = h;
+  return h;
 }
 
 void OctoBvh::releaseBuildScratch() {
@@ -335,7 +350,16 @@ void OctoBvh::releaseBuildScratch() {
 
 void OctoBvh::build(uint32_t c, int s, const Cube& cube, BuildItem* items, uint32_t count) {
   if (count <= uint32_t(kLeafCapacity) || cube.level == kMinLevel) {
-    for (uint32_t i = 0; i < count; ++i) heldAdd(c, s, items[i].e);
+    if (bulk_) {
+      // note: a leaf's inputs are scattered over the input arrays; asking for all of them
+      // first overlaps their misses instead of taking them one placement at a time.
+      for (uint32_t i = 0; i < count; ++i) {
+        __builtin_prefetch(&bulk_->bounds[items[i].e]);
+        __builtin_prefetch(&bulk_->filters[items[i].e]);
+        __builtin_prefetch(&bulk_->payloads[items[i].e]);
+      }
+    }
+    for (uint32_t i = 0; i < count; ++i) heldAdd(c, s, placeBuilt(items[i].e));
     refit(c, s);
     return;
   }
@@ -346,7 +370,7 @@ void OctoBvh::build(uint32_t c, int s, const Cube& cube, BuildItem* items, uint3
   const uint32_t child = allocCluster(cube.level - 1);
   clusters_[c].child[s] = child;
   if (!forced) {
-    for (uint32_t i = 0; i < big; ++i) heldAdd(c, s, items[i].e);
+    for (uint32_t i = 0; i < big; ++i) heldAdd(c, s, placeBuilt(items[i].e));
     buildOctants(child, cube, items + big, count - big);
   } else if (big == count) {
     // Nothing fits a child: the large elements are forced into the children.
@@ -393,22 +417,35 @@ void OctoBvh::buildOctants(uint32_t sub, const Cube& cube, BuildItem* items, uin
     if (counts[o]) build(sub, o, cube.child(o), items + start[o], counts[o]);
 }
 
-int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {
-  // The extreme centres on each axis decide, as every centre must lie in [-2^R, 2^R).
+namespace {
+// The canonical root level of a set of elements: the extreme centres on each axis decide, as
+// every centre must lie in [-2^R, 2^R), and so does the largest min level.
+struct RootLevelScan {
   int R = kMinLevel;
   double lo = 0, hi = 0;
-  for (uint32_t e : elems) {
-    const ElementRecord& r = elements_[e];
-    R = std::max(R, minLevelOf(r));
-    double ctr[3];
-    centreOf(r, ctr);
-    for (double v : ctr) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
+  void add(int minLevel, const double ctr[3]) {
+    R = std::max(R, minLevel);
+    for (int k = 0; k < 3; ++k) {
+      lo = std::min(lo, ctr[k]);
+      hi = std::max(hi, ctr[k]);
     }
   }
-  while (!(lo >= -pow2(R) && hi < pow2(R))) ++R;
-  return R + 1;
+  int level() const {
+    int r = R;
+    while (!(lo >= -pow2(r) && hi < pow2(r))) ++r;
+    return r + 1;
+  }
+};
+}  // namespace
+
+int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {
+  RootLevelScan scan;
+  for (uint32_t e : elems) {
+    double ctr[3];
+    centreOf(elements_[e], ctr);
+    scan.add(minLevelOf(elements_[e]), ctr);
+  }
+  return scan.level();
 }
 
 std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
@@ -418,25 +455,44 @@ std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const s
     throw InvalidInput("OctoBvh::bulkLoad: bounds, filters and payloads differ in length (" +
                        std::to_string(bounds.size()) + ", " + std::to_string(filters.size()) + ", " +
                        std::to_string(payloads.size()) + ")");
-  for (const Aabb& b : bounds) validateElement(b, "OctoBvh::bulkLoad");
   if (bounds.size() > elements_.capacity())
     throw CapacityExceeded("OctoBvh::bulkLoad: " + std::to_string(bounds.size()) + " elements exceed the capacity of " +
                            std::to_string(elements_.capacity()));
-  std::vector<uint32_t> handles(bounds.size());
-  for (size_t i = 0; i < bounds.size(); ++i) {
-    handles[i] = elements_.allocate();
-    ElementRecord& r = elements_[handles[i]];
-    for (int k = 0; k < 3; ++k) {
-      r.min[k] = bounds[i].min[k];
-      r.max[k] = bounds[i].max[k];
+  // note: the records are written as the build places each element at its node, so the pool
+  // holds them in the order the leaves list them: a query reading a leaf's records meets
+  // neighbouring lines, not one random line per element. The tree, and the order inside each
+  // leaf, are what building from handles in input order gives; only the handle values differ.
+  const uint32_t n = uint32_t(bounds.size());
+  std::vector<uint32_t> handles(n);
+  if (n == 0) return handles;
+  std::vector<BuildItem>& items = buildScratch_;
+  items.resize(n);
+  RootLevelScan scan;
+  try {
+    for (uint32_t i = 0; i < n; ++i) {  // one pass over the input: checked and itemised
+      validateElement(bounds[i], "OctoBvh::bulkLoad");
+      ElementRecord r;
+      for (int k = 0; k < 3; ++k) {
+        r.min[k] = bounds[i].min[k];
+        r.max[k] = bounds[i].max[k];
+      }
+      buildItemOf(r, i, items[i]);
+      scan.add(items[i].minLevel, items[i].ctr);
     }
-    r.filter = filters[i];
-    r.payload = payloads[i];
+  } catch (...) {
+    releaseBuildScratch();  // nothing else was touched
+    throw;
   }
-  if (handles.empty()) return handles;
-  rootLevel_ = canonicalRootLevel(handles);
+  rootLevel_ = scan.level();
   clusters_[rootCluster_].level = int8_t(rootLevel_);
-  buildFrom(rootCluster_, 0, rootCube(), handles.data(), uint32_t(handles.size()));
+  BulkInput input{bounds.data(), filters.data(), payloads.data(), handles.data()};
+  struct BulkScope {  // the build reads bulk_ only while bulkLoad runs
+    OctoBvh& tree;
+    ~BulkScope() { tree.bulk_ = nullptr; }
+  } scope{*this};
+  bulk_ = &input;
+  build(rootCluster_, 0, rootCube(), items.data(), n);
+  releaseBuildScratch();
   return handles;
 }
 

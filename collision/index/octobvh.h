@@ -300,6 +300,10 @@ class OctoBvh {
   };
   /// The canonical subtree of the given elements at the (empty) node (c, s).
   void buildFrom(uint32_t c, int s, const Cube& cube, const uint32_t* elems, uint32_t count);
+  static void buildItemOf(const octobvh::ElementRecord& r, uint32_t e, BuildItem& it);
+  /// The element handle a build holds at a node: the item's own, or during bulkLoad the record
+  /// written now (see bulk_).
+  uint32_t placeBuilt(uint32_t e);
   void build(uint32_t c, int s, const Cube& cube, BuildItem* items, uint32_t count);
   void buildOctants(uint32_t sub, const Cube& cube, BuildItem* items, uint32_t count);
   /// Sorts the items by the child cube of `cube` holding their centres (counts and starts per
@@ -352,6 +356,15 @@ class OctoBvh {
   std::vector<uint32_t> mergeScratch_;  ///< mergeIntoLeaf's (edits are exclusive): no allocation per merge
   std::vector<BuildItem> buildScratch_; ///< buildFrom's and removeMany's items (kept when small)
   const uint8_t* removing_ = nullptr;   ///< during removeMany: by handle, 1 for those it takes
+  /// During bulkLoad: the build's items name input positions, and each element's record is
+  /// allocated and written from the input when the build places it at its node.
+  struct BulkInput {
+    const Aabb* bounds;
+    const uint32_t* filters;
+    const uint32_t* payloads;
+    uint32_t* handles;  ///< handles[input] = its element's handle
+  };
+  BulkInput* bulk_ = nullptr;
 };
 
 }  // namespace bw

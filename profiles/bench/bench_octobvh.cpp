@@ -10,7 +10,8 @@
 // Edit/<Index>: insert, remove and update at 1M (ns per op); for OctoBVH also remove and update
 // by a loop that asks for each group of 32 edits' paths first (remove_prefetched_ns,
 // update_prefetched_ns: OctoBvh::prefetchPaths). Overlap2m/<Index>, RayClosest200m/<Index>,
-// LongRay/<Index>: per-query time and box tests. RayOrder/<order>: front-to-back vs reversed
+// LongRay/<Index>: per-query time and box tests; the OctoBVHBulkLoaded rows query the same 1M
+// bricks bulk-loaded (records in leaf order) instead of inserted. RayOrder/<order>: front-to-back vs reversed
 // child order. EditsThenRays/OctoBVH: 1000 moved bricks, then the same rays again; and another
 // 1000 moves with their paths asked for first (edits_1000_prefetched_ms).
 // The 1M rows run on the sparse build (`/sparse`) and on the dense one (`/dense`: the same bricks
@@ -348,13 +349,23 @@ void LoadLighthouseTiled_btDbvtOptimized(benchmark::State& s) { loadLighthouse<b
 
 constexpr uint32_t kMillion = 1'000'000;
 
+// Built by inserting the bricks one by one (handles, so records, in generation order), or for
+// the `BulkLoaded` rows by OctoBvh::bulkLoad (records in leaf order), as a grid is loaded from a file.
 template <class Index>
-Index& prebuilt(bool dense) {
-  static std::unique_ptr<Index> built[2];
-  auto& index = built[dense ? 1 : 0];
+Index& prebuilt(bool dense, bool bulk = false) {
+  static std::unique_ptr<Index> built[2][2];
+  auto& index = built[dense ? 1 : 0][bulk ? 1 : 0];
   if (!index) {
     index = std::make_unique<Index>(typename Index::Config{kMillion + 100'000});
     const auto& b = build(kMillion, dense);
+    if constexpr (requires { index->bulkLoad(b, std::vector<uint32_t>(), std::vector<uint32_t>()); }) {
+      if (bulk) {
+        std::vector<uint32_t> payloads(kMillion);
+        for (uint32_t i = 0; i < kMillion; ++i) payloads[i] = i;
+        index->bulkLoad(b, std::vector<uint32_t>(kMillion, 1u), payloads);
+        return *index;
+      }
+    }
     for (uint32_t i = 0; i < kMillion; ++i) index->insert(b[i], 1, i);
   }
   return *index;
@@ -515,8 +526,8 @@ void Edit_btDbvt(benchmark::State& state, bool dense) {
 // ---------------------------------------------------------------- overlap 2 m
 
 template <class Index>
-void overlapWith(benchmark::State& state, const char* name, bool dense) {
-  const Index& index = prebuilt<Index>(dense);
+void overlapWith(benchmark::State& state, const char* name, bool dense, bool bulk = false) {
+  const Index& index = prebuilt<Index>(dense, bulk);
   const auto centres = queryCentres(4096, 11, dense);
   bw::QueryStats st;
   uint64_t hits = 0, q = 0;
@@ -531,6 +542,9 @@ void overlapWith(benchmark::State& state, const char* name, bool dense) {
   summary()[std::string("overlap_tests_") + name + buildKey(dense)] = double(st.boxTests) / double(state.iterations());
 }
 void Overlap2m_OctoBVH(benchmark::State& state, bool dense) { overlapWith<bw::OctoBvh>(state, "OctoBVH", dense); }
+void Overlap2m_OctoBVHBulkLoaded(benchmark::State& state, bool dense) {
+  overlapWith<bw::OctoBvh>(state, "OctoBVHBulkLoaded", dense, true);
+}
 void Overlap2m_LooseOctree(benchmark::State& state, bool dense) { overlapWith<bw::LooseOctree>(state, "LooseOctree", dense); }
 void overlapDbvt(benchmark::State& state, bool optimized, const std::string& name, bool dense) {
   DbvtBuild& d = prebuiltDbvt(optimized, dense);
@@ -560,8 +574,9 @@ void Overlap2m_btDbvtOptimized(benchmark::State& state, bool dense) { overlapDbv
 // ---------------------------------------------------------------- rays
 
 template <class Index>
-void rayWith(benchmark::State& state, const std::string& key, float length, bw::RayChildOrder order, bool dense = false) {
-  const Index& index = prebuilt<Index>(dense);
+void rayWith(benchmark::State& state, const std::string& key, float length, bw::RayChildOrder order, bool dense = false,
+             bool bulk = false) {
+  const Index& index = prebuilt<Index>(dense, bulk);
   const auto origins = queryCentres(4096, 13, dense);
   const auto dirs = rayDirections(4096, 14);
   bw::QueryStats st;
@@ -580,6 +595,9 @@ void rayWith(benchmark::State& state, const std::string& key, float length, bw::
 }
 void RayClosest200m_OctoBVH(benchmark::State& s, bool dense) {
   rayWith<bw::OctoBvh>(s, "ray_tests_OctoBVH", 200.f, bw::RayChildOrder::FrontToBack, dense);
+}
+void RayClosest200m_OctoBVHBulkLoaded(benchmark::State& s, bool dense) {
+  rayWith<bw::OctoBvh>(s, "ray_tests_OctoBVHBulkLoaded", 200.f, bw::RayChildOrder::FrontToBack, dense, true);
 }
 void RayClosest200m_LooseOctree(benchmark::State& s, bool dense) {
   rayWith<bw::LooseOctree>(s, "ray_tests_LooseOctree", 200.f, bw::RayChildOrder::FrontToBack, dense);
@@ -776,10 +794,12 @@ BW_SPARSE_DENSE(Edit_OctoBVH, ->Iterations(3)->Unit(benchmark::kMillisecond));
 BW_SPARSE_DENSE(Edit_LooseOctree, ->Iterations(3)->Unit(benchmark::kMillisecond));
 BW_SPARSE_DENSE(Edit_btDbvt, ->Iterations(3)->Unit(benchmark::kMillisecond));
 BW_SPARSE_DENSE(Overlap2m_OctoBVH, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(Overlap2m_OctoBVHBulkLoaded, ->Unit(benchmark::kMicrosecond));
 BW_SPARSE_DENSE(Overlap2m_LooseOctree, ->Unit(benchmark::kMicrosecond));
 BW_SPARSE_DENSE(Overlap2m_btDbvt, ->Unit(benchmark::kMicrosecond));
 BW_SPARSE_DENSE(Overlap2m_btDbvtOptimized, ->Unit(benchmark::kMicrosecond));
 BW_SPARSE_DENSE(RayClosest200m_OctoBVH, ->Unit(benchmark::kMicrosecond));
+BW_SPARSE_DENSE(RayClosest200m_OctoBVHBulkLoaded, ->Unit(benchmark::kMicrosecond));
 BW_SPARSE_DENSE(RayClosest200m_LooseOctree, ->Unit(benchmark::kMicrosecond));
 BW_SPARSE_DENSE(RayClosest200m_btDbvt, ->Unit(benchmark::kMicrosecond));
 BW_SPARSE_DENSE(RayClosest200m_btDbvtOptimized, ->Unit(benchmark::kMicrosecond));
