@@ -332,14 +332,7 @@ void OctoBvh::buildItemOf(const ElementRecord& r, uint32_t e, BuildItem& it) {
 uint32_t OctoBvh::placeBuilt(uint32_t e) {
   if (!bulk_) return e;
   const uint32_t h = elements_.allocate();
-  ElementRecord& r = elements_[h];
-  const Aabb& b = bulk_->bounds[e];
-  for (int k = 0; k < 3; ++k) {
-    r.min[k] = b.min[k];
-    r.max[k] = b.max[k];
-  }
-  r.filter = bulk_->filters[e];
-  r.payload = bulk_->payloads[e];
+  elements_[h] = ElementRecord::of(bulk_->bounds[e], bulk_->filters[e], bulk_->payloads[e]);
   bulk_->handles[e] = h;
   return h;
 }
@@ -471,12 +464,7 @@ std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const s
   try {
     for (uint32_t i = 0; i < n; ++i) {  // one pass over the input: checked and itemised
       validateElement(bounds[i], "OctoBvh::bulkLoad");
-      ElementRecord r;
-      for (int k = 0; k < 3; ++k) {
-        r.min[k] = bounds[i].min[k];
-        r.max[k] = bounds[i].max[k];
-      }
-      buildItemOf(r, i, items[i]);
+      buildItemOf(ElementRecord::of(bounds[i], 0, 0), i, items[i]);
       scan.add(items[i].minLevel, items[i].ctr);
     }
   } catch (...) {

@@ -17,13 +17,7 @@ uint32_t OctoBvh::insert(const Aabb& bounds, uint32_t filter, uint32_t payload) 
   validateElement(bounds, "OctoBvh::insert");
   reserveHeadroom("OctoBvh::insert");
   const uint32_t e = elements_.allocate();
-  ElementRecord& r = elements_[e];
-  for (int k = 0; k < 3; ++k) {
-    r.min[k] = bounds.min[k];
-    r.max[k] = bounds.max[k];
-  }
-  r.filter = filter;
-  r.payload = payload;
+  elements_[e] = ElementRecord::of(bounds, filter, payload);
   const Placement p = placementOf(e);
   growRootToHold(p.ctr, p.minLevel);
   insertAt(rootCluster_, 0, rootCube(), p);
@@ -202,12 +196,7 @@ void OctoBvh::update(uint32_t handle, const Aabb& bounds, uint32_t filter) {
   validateElement(bounds, "OctoBvh::update");
   reserveHeadroom("OctoBvh::update");
   const Placement old = placementOf(handle);
-  ElementRecord moved = elements_[handle];
-  for (int k = 0; k < 3; ++k) {
-    moved.min[k] = bounds.min[k];
-    moved.max[k] = bounds.max[k];
-  }
-  moved.filter = filter;
+  const ElementRecord moved = ElementRecord::of(bounds, filter, elements_[handle].payload);
   Placement p{handle, minLevelOf(moved), {}};
   centreOf(moved, p.ctr);
   if (p.minLevel == old.minLevel && !holdsRootUp(old) && !holdsRootUp(p) && updateInPlace(old, p, moved)) return;

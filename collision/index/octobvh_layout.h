@@ -91,6 +91,9 @@ struct ElementRecord {
   uint32_t filter;   // 28
   uint32_t payload;  // 32
   Aabb bounds() const { return {{min[0], min[1], min[2]}, {max[0], max[1], max[2]}}; }
+  static ElementRecord of(const Aabb& b, uint32_t filter, uint32_t payload) {
+    return {{b.min.x(), b.min.y(), b.min.z()}, {b.max.x(), b.max.y(), b.max.z()}, filter, payload};
+  }
 };
 static_assert(sizeof(ElementRecord) == 32);
 

@@ -87,11 +87,9 @@ void OctoBvh::prefetchInsertPaths(std::span<const Aabb> bounds) const {
     for (const Aabb& b : group) {
       // Only boxes an insert would take without growing the root (anything else, bad input
       // included, is skipped: insert() reports it).
-      ElementRecord r{};
+      const ElementRecord r = ElementRecord::of(b, 0, 0);
       bool inside = true;
       for (int k = 0; k < 3; ++k) {
-        r.min[k] = b.min[k];
-        r.max[k] = b.max[k];
         const double c = (double(b.min[k]) + double(b.max[k])) * 0.5;
         inside = inside && std::isfinite(c) && b.min[k] <= b.max[k] && c >= -half && c < half;
       }

@@ -3,7 +3,12 @@
 //   build/release/bin/bench_octobvh --benchmark_counters_tabular=true
 //
 // Load/<Index>/<n>: the article's load workload: insert each brick, then query a box around it
-// (as a game does to hide adjacent faces); counters box_tests, ns_per_brick, bytes_per_element.
+// (as a game does to hide adjacent faces); counters box_tests, element_tests_per_brick (the rest
+// are node tests), ns_per_brick, bytes_per_element. LoadWithoutLarge/<Index>: the same at 1M
+// without the elements over 8 m (what the large ones cost each index). LoadFloor/OctoBVH and
+// LoadLighthouseFloor/OctoBVH (0 untiled, 1 tiled): the same OctoBVH runs with each query's floor
+// beside it (floor_tests_per_brick: the fewest tests any exact walk of that tree could make, see
+// octobvh_walk_floor.h; every 16th query on the big builds), printed against the loose octree.
 // LoadLighthouse/<Index> and LoadLighthouseTiled/<Index>: the same workload on the real save
 // ../shared/data/Lighthouse_Island.brs (25,427 bricks) and on it tiled 10 x 10 (2,542,700 bricks,
 // the article's build size), bricks in file order, tile by tile.
@@ -47,6 +52,7 @@
 #include "collision/core/seeded_random.h"
 #include "collision/index/loose_octree.h"
 #include "collision/index/octobvh.h"
+#include "profiles/bench/octobvh_walk_floor.h"
 
 namespace {
 
@@ -229,6 +235,7 @@ void loadIndex(benchmark::State& state, std::span<const Aabb> bricks, const char
     state.counters["bricks"] = double(n);
     state.counters["box_tests"] = double(st.boxTests);
     state.counters["box_tests_per_brick"] = double(st.boxTests) / n;
+    state.counters["element_tests_per_brick"] = double(st.elementTests) / n;  // the rest test nodes
     state.counters["ns_per_brick"] = s * 1e9 / n;
     state.counters["hits_per_query"] = double(found) / n;
     if constexpr (std::is_same_v<Index, bw::OctoBvh>) {
@@ -309,11 +316,71 @@ void loadWith(benchmark::State& state, const char* name) {
 
 void Load_OctoBVH(benchmark::State& state) { loadWith<bw::OctoBvh>(state, "OctoBVH"); }
 void Load_LooseOctree(benchmark::State& state) { loadWith<bw::LooseOctree>(state, "LooseOctree"); }
+
+// The same build without its large elements (largest extent over 8 m: the plates and ramps, 7%
+// of the size mix): what they cost each index is the difference from the Load rows.
+const std::vector<Aabb>& withoutLarge(uint32_t n, bool dense) {
+  static std::map<std::pair<uint32_t, bool>, std::vector<Aabb>> cache;
+  auto it = cache.find({n, dense});
+  if (it == cache.end()) {
+    std::vector<Aabb> kept;
+    for (const Aabb& b : build(n, dense))
+      if ((b.max - b.min).maxCoeff() <= 8.f) kept.push_back(b);
+    it = cache.emplace(std::pair(n, dense), std::move(kept)).first;
+  }
+  return it->second;
+}
+template <class Index>
+void loadWithoutLarge(benchmark::State& state, const char* name) {
+  loadIndex<Index>(state, withoutLarge(uint32_t(state.range(0)), state.range(1) != 0), name, loadKey(state) + "_nolarge");
+}
+void LoadWithoutLarge_OctoBVH(benchmark::State& state) { loadWithoutLarge<bw::OctoBvh>(state, "OctoBVH"); }
+void LoadWithoutLarge_LooseOctree(benchmark::State& state) { loadWithoutLarge<bw::LooseOctree>(state, "LooseOctree"); }
 void Load_btDbvt(benchmark::State& state) {
   loadDbvt(state, build(uint32_t(state.range(0)), state.range(1) != 0), loadKey(state));
 }
 void Load_btDbvtOptimized(benchmark::State& state) {
   loadDbvtOptimized(state, build(uint32_t(state.range(0)), state.range(1) != 0), loadKey(state));
+}
+
+// The load workload once more, its OctoBVH queries beside their floor (octobvh_walk_floor.h: the
+// fewest tests any exact walk of the same tree makes), every `step`th query.
+void loadFloor(benchmark::State& state, std::span<const Aabb> bricks, const std::string& key, uint32_t step) {
+  const uint32_t n = uint32_t(bricks.size());
+  for (auto _ : state) {
+    bw::OctoBvh index(bw::OctoBvh::Config{n + 1024});
+    bw::bench::OctoBvhWalkFloor floor(index);
+    std::vector<uint32_t> hits;
+    uint64_t walk = 0, least = 0, queries = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      index.insert(bricks[i], 1, i);
+      if (i % step) continue;
+      bw::QueryStats st;
+      hits.clear();
+      index.overlap(around(bricks[i]), 1, [&](uint32_t e) { hits.push_back(e); }, &st);
+      walk += st.boxTests;
+      least += floor.tests(hits);
+      ++queries;
+    }
+    state.counters["box_tests_per_brick"] = double(walk) / double(queries);
+    state.counters["floor_tests_per_brick"] = double(least) / double(queries);
+    state.counters["queries"] = double(queries);
+    summary()["load_floor_" + key] = double(least) / double(queries);
+    summary()["load_floor_walk_" + key] = double(walk) / double(queries);
+  }
+}
+void LoadFloor_OctoBVH(benchmark::State& state) {
+  loadFloor(state, build(uint32_t(state.range(0)), state.range(1) != 0), loadKey(state), 16);
+}
+void LoadLighthouseFloor_OctoBVH(benchmark::State& state) {
+  std::string error;
+  const bool tiled = state.range(0) != 0;
+  const std::vector<Aabb>& bricks = lighthouseBuild(tiled, error);
+  if (!error.empty()) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  loadFloor(state, bricks, tiled ? "lighthouse_tiled" : "lighthouse", tiled ? 16 : 1);
 }
 
 struct btDbvtOptimizedTag {};  // selects loadDbvtOptimized in loadLighthouse
@@ -717,10 +784,11 @@ void printSummary() {
   auto get = [&](const std::string& k) { return s.count(k) ? s[k] : 0.0; };
   std::printf("\n== Comparisons (same run)\n");
   for (const std::string key :
-       {"100000", "1000000", "4000000", "100000_dense", "1000000_dense", "lighthouse", "lighthouse_tiled"}) {
+       {"100000", "1000000", "4000000", "100000_dense", "1000000_dense", "1000000_nolarge", "1000000_dense_nolarge",
+        "lighthouse", "lighthouse_tiled"}) {
     if (!get("load_tests_OctoBVH_" + key) || !get("load_tests_LooseOctree_" + key)) continue;
     const double octo = get("load_tests_OctoBVH_" + key), loose = get("load_tests_LooseOctree_" + key);
-    std::printf("load %-16s %8.0f bricks: box tests LooseOctree/OctoBVH = %.2fx (%.3g vs %.3g), time LooseOctree/OctoBVH = %.2fx "
+    std::printf("load %-22s %8.0f bricks: box tests LooseOctree/OctoBVH = %.2fx (%.3g vs %.3g), time LooseOctree/OctoBVH = %.2fx "
                 "(%.2f s vs %.2f s)",
                 key.c_str(), get("load_n_" + key), loose / octo, loose, octo,
                 get("load_s_LooseOctree_" + key) / get("load_s_OctoBVH_" + key), get("load_s_LooseOctree_" + key),
@@ -734,6 +802,12 @@ void printSummary() {
                   get("load_tests_btDbvt_" + key), get("load_s_btDbvt_" + key) / get("load_s_OctoBVH_" + key),
                   get("load_s_btDbvt_" + key));
     std::printf("\n");
+    if (const double floor = get("load_floor_" + key)) {
+      const double loosePerQuery = loose / get("load_n_" + key);
+      std::printf("  floor of the canonical tree (any exact walk of it): %.1f tests a query, its walk %.1f (%.2fx the floor); "
+                  "LooseOctree / floor = %.2fx, the most any walk of this tree could reach\n",
+                  floor, get("load_floor_walk_" + key), get("load_floor_walk_" + key) / floor, loosePerQuery / floor);
+    }
   }
   if (get("order_tests_front"))
     std::printf("ray child order: reversed/front-to-back box tests = %.2fx (%.0f vs %.0f)\n",
@@ -775,6 +849,10 @@ void printSummary() {
 #define BW_LOAD_SIZES ->Args({100'000, 0})->Args({1'000'000, 0})->Args({100'000, 1})->Args({1'000'000, 1})
 BENCHMARK(Load_OctoBVH) BW_LOAD_SIZES->Args({4'000'000, 0})->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(Load_LooseOctree) BW_LOAD_SIZES->Args({4'000'000, 0})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadWithoutLarge_OctoBVH)->Args({1'000'000, 0})->Args({1'000'000, 1})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadFloor_OctoBVH)->Args({1'000'000, 0})->Args({1'000'000, 1})->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadLighthouseFloor_OctoBVH)->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(LoadWithoutLarge_LooseOctree)->Args({1'000'000, 0})->Args({1'000'000, 1})->Iterations(1)->Unit(benchmark::kMillisecond);
 // btDbvt stops at 1M: its incremental load is superlinear here (1M took 48 s, 4M did not finish in 5 min).
 BENCHMARK(Load_btDbvt) BW_LOAD_SIZES->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(Load_btDbvtOptimized) BW_LOAD_SIZES->Iterations(1)->Unit(benchmark::kMillisecond);
