@@ -395,22 +395,25 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   BrickGrid::Move move = old.prepareMove(part, *grid);
   const std::vector<uint32_t>& ids = move.newIds();
   std::unique_ptr<BrickConnectivity> partLinks;
-  // The part's index build, the old grid's bulk removal and the links' move touch three
-  // separate things: on two threads a big part costs about its build (Split_CutInTwo, 50k
-  // bricks: 17 -> 12 ms). note: tried before the removal gave its emptied pages back in runs
-  // (PoolIndexSpace::DeferPageRelease), this was slower than one thread: a madvise per emptied
-  // block, each flushing the TLB of the core that was building.
+  // The part's index build, its bricks and mass, the old grid's bulk removal and the links'
+  // move touch four separate things: on two threads a big part costs about its build
+  // (Split_CutInTwo, 50k bricks: 17 -> 12 ms). note: tried before the removal gave its emptied
+  // pages back in runs (PoolIndexSpace::DeferPageRelease), this was slower than one thread: a
+  // madvise per emptied block, each flushing the TLB of the core that was building. The build
+  // goes first and the mass second: oneTBB's halves give one thread both while the other takes
+  // the removal and the links, and that thread is then free to take the mass from it.
   const auto step = [&](uint32_t k) {
-    if (k == 0) grid->receiveMove(move);
-    else if (k == 1) old.releaseMove(move);
+    if (k == 0) grid->receiveMoveIndex(move);
+    else if (k == 1) grid->receiveMoveBricks(move);
+    else if (k == 2) old.releaseMove(move);
     else partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   };
   if (part.size() >= tuning::kParallelPartBricks) {
-    jobs_.parallelFor(0, 3, 1, [&](uint32_t begin, uint32_t end) {
+    jobs_.parallelFor(0, 4, 1, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) step(k);
     });
   } else {
-    for (uint32_t k = 0; k < 3; ++k) step(k);
+    for (uint32_t k = 0; k < 4; ++k) step(k);
   }
   if (renderChunks_)  // the bricks as they were, now in the part's grid
     for (uint32_t id : ids) renderChunks_->removing(g, grid->brick(id));

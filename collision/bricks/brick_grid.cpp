@@ -76,19 +76,26 @@ std::vector<uint32_t> BrickGrid::placeValidBricks(const std::vector<Brick>& bric
 }
 
 void BrickGrid::fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds) {
-  std::vector<uint32_t> filters;
-  filters.reserve(bricks.size());
-  for (const Brick& b : bricks) filters.push_back(b.filter);
-  std::vector<uint32_t> elements;
   try {
-    elements = index_.bulkLoad(bounds, filters, ids);  // validates every box before building
+    indexValidBricks(ids, bricks, bounds);
   } catch (...) {
     for (uint32_t id : ids) bricks_.free(id);
     throw;
   }
+  addValidBricks(ids, bricks);
+}
+
+void BrickGrid::indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds) {
+  std::vector<uint32_t> filters;
+  filters.reserve(bricks.size());
+  for (const Brick& b : bricks) filters.push_back(b.filter);
+  const std::vector<uint32_t> elements = index_.bulkLoad(bounds, filters, ids);  // validates every box before building
+  for (size_t i = 0; i < ids.size(); ++i) bricks_.get<1>(ids[i]) = elements[i];
+}
+
+void BrickGrid::addValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks) {
   for (size_t i = 0; i < bricks.size(); ++i) {
     bricks_.get<0>(ids[i]) = bricks[i];
-    bricks_.get<1>(ids[i]) = elements[i];
     if (!referenceSet_) {
       reference_ = bricks[i].position.cast<double>();  // as placeBrick: moments about the first brick
       referenceSet_ = true;
@@ -153,6 +160,16 @@ BrickGrid::Move BrickGrid::prepareMove(std::span<const uint32_t> ids, BrickGrid&
 void BrickGrid::receiveMove(Move& m) {
   BW_ASSERT(m.into_ == this);
   fillValidBricks(m.newIds_, m.bricks_, m.bounds_);
+}
+
+void BrickGrid::receiveMoveIndex(Move& m) {
+  BW_ASSERT(m.into_ == this);
+  indexValidBricks(m.newIds_, m.bricks_, m.bounds_);
+}
+
+void BrickGrid::receiveMoveBricks(Move& m) {
+  BW_ASSERT(m.into_ == this);
+  addValidBricks(m.newIds_, m.bricks_);
 }
 
 void BrickGrid::releaseMove(Move& m) {

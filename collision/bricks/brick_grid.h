@@ -137,6 +137,9 @@ class BrickGrid {
   /// throws as moveBricks does); then receiveMove on `into` (the index build) and releaseMove
   /// on this grid (the bulk removal), in either order or at the same time, each once. The end
   /// state is moveBricks'. Only an allocation failure can stop a step half way.
+  /// receiveMove is itself two steps that touch separate state and may run at the same time:
+  /// receiveMoveIndex (the index build, and each brick's element) and receiveMoveBricks (the
+  /// bricks and the grid's mass).
   class Move {
    public:
     /// The bricks' ids in `into`, in the order of the ids moved (known once prepared).
@@ -151,8 +154,10 @@ class BrickGrid {
     std::vector<Aabb> bounds_;
   };
   Move prepareMove(std::span<const uint32_t> ids, BrickGrid& into);
-  /// Called on the grid the bricks move into.
+  /// Called on the grid the bricks move into: receiveMoveIndex, then receiveMoveBricks.
   void receiveMove(Move& move);
+  void receiveMoveIndex(Move& move);
+  void receiveMoveBricks(Move& move);
   /// Called on the grid the bricks leave.
   void releaseMove(Move& move);
   /// Counts edits; caches keyed on it are stale when it changes.
@@ -227,8 +232,14 @@ class BrickGrid {
   float roundingMargin(const Vec3f& queryPoint) const;
   /// placeBricks' work once the bricks are known to be valid and the grid empty.
   std::vector<uint32_t> placeValidBricks(const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
-  /// placeValidBricks with the bricks' ids allocated already (freed again if the build throws).
+  /// placeValidBricks with the bricks' ids allocated already (freed again if the build throws):
+  /// indexValidBricks, then addValidBricks.
   void fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
+  /// The index's bulk load and each id's element handle (the pool's column 1); throws before
+  /// anything changes.
+  void indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
+  /// The bricks (column 0) and their mass.
+  void addValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks);
   void rebaseIfCancelling();
 };
 

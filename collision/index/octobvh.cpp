@@ -339,23 +339,25 @@ uint32_t OctoBvh::placeBuilt(uint32_t e) {
 
 void OctoBvh::releaseBuildScratch() {
   if (buildScratch_.capacity() > kKeptBuildItems) std::vector<BuildItem>().swap(buildScratch_);
+  if (runScratch_.capacity() > kKeptBuildItems) std::vector<BuildItem>().swap(runScratch_);
+}
+
+void OctoBvh::buildLeaf(uint32_t c, int s, const BuildItem* items, uint32_t count) {
+  if (bulk_) {
+    // note: a leaf's inputs are scattered over the input arrays; asking for all of them
+    // first overlaps their misses instead of taking them one placement at a time.
+    for (uint32_t i = 0; i < count; ++i) {
+      __builtin_prefetch(&bulk_->bounds[items[i].e]);
+      __builtin_prefetch(&bulk_->filters[items[i].e]);
+      __builtin_prefetch(&bulk_->payloads[items[i].e]);
+    }
+  }
+  for (uint32_t i = 0; i < count; ++i) heldAdd(c, s, placeBuilt(items[i].e));
+  refit(c, s);
 }
 
 void OctoBvh::build(uint32_t c, int s, const Cube& cube, BuildItem* items, uint32_t count) {
-  if (count <= uint32_t(kLeafCapacity) || cube.level == kMinLevel) {
-    if (bulk_) {
-      // note: a leaf's inputs are scattered over the input arrays; asking for all of them
-      // first overlaps their misses instead of taking them one placement at a time.
-      for (uint32_t i = 0; i < count; ++i) {
-        __builtin_prefetch(&bulk_->bounds[items[i].e]);
-        __builtin_prefetch(&bulk_->filters[items[i].e]);
-        __builtin_prefetch(&bulk_->payloads[items[i].e]);
-      }
-    }
-    for (uint32_t i = 0; i < count; ++i) heldAdd(c, s, placeBuilt(items[i].e));
-    refit(c, s);
-    return;
-  }
+  if (count <= uint32_t(kLeafCapacity) || cube.level == kMinLevel) return buildLeaf(c, s, items, count);
   // Elements that cannot go below this level first.
   BuildItem* mid = std::partition(items, items + count, [&](const BuildItem& it) { return it.minLevel >= cube.level; });
   const uint32_t big = uint32_t(mid - items);
@@ -453,8 +455,8 @@ std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const s
                            std::to_string(elements_.capacity()));
   // note: the records are written as the build places each element at its node, so the pool
   // holds them in the order the leaves list them: a query reading a leaf's records meets
-  // neighbouring lines, not one random line per element. The tree, and the order inside each
-  // leaf, are what building from handles in input order gives; only the handle values differ.
+  // neighbouring lines, not one random line per element. The tree is what inserting them gives;
+  // inside a node the elements are in the sorted build's order (octobvh_sorted_build.cpp).
   const uint32_t n = uint32_t(bounds.size());
   std::vector<uint32_t> handles(n);
   if (n == 0) return handles;
@@ -479,7 +481,10 @@ std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const s
     ~BulkScope() { tree.bulk_ = nullptr; }
   } scope{*this};
   bulk_ = &input;
-  build(rootCluster_, 0, rootCube(), items.data(), n);
+  // note: one radix sort instead of build()'s partition at every level (the same tree; a 50k
+  // brick part's build 46.6 -> 32.6 M instructions, octobvh_sorted_build.cpp).
+  const std::vector<SortedItem> sorted = sortForBuild(items);
+  buildSorted(rootCluster_, 0, rootCube(), 0, sorted.data(), n, items.data());
   releaseBuildScratch();
   return handles;
 }

@@ -305,6 +305,25 @@ class OctoBvh {
   /// written now (see bulk_).
   uint32_t placeBuilt(uint32_t e);
   void build(uint32_t c, int s, const Cube& cube, BuildItem* items, uint32_t count);
+  /// A leaf at the (empty) node (c, s) holding the items, in their order.
+  void buildLeaf(uint32_t c, int s, const BuildItem* items, uint32_t count);
+  /// bulkLoad's build (octobvh_sorted_build.cpp): build()'s tree from items sorted once by their
+  /// paths (sortForBuild, with rootLevel_ set), node (c, s) at `depth` below the root. Only
+  /// bulkLoad's items (item i is input i, bulk_ set).
+  struct SortedItem {
+    uint64_t key;   ///< the item's path and natural depth (sortedBuildKey)
+    uint32_t item;  ///< its index in the build's items (bulkLoad: its input position)
+  };
+  uint64_t sortedBuildKey(const BuildItem& it) const;
+  /// The items' keys, sorted (by key, then index).
+  std::vector<SortedItem> sortForBuild(const std::vector<BuildItem>& items) const;
+  void buildSorted(uint32_t c, int s, const Cube& cube, int depth, const SortedItem* sorted, uint32_t count,
+                   const BuildItem* items);
+  void buildOctantsSorted(uint32_t sub, const Cube& cube, int depth, const SortedItem* sorted, uint32_t count,
+                          const BuildItem* items);
+  /// build()'s subtree of a run of sorted items (where keys cannot order them further).
+  void buildRunUnsorted(uint32_t c, int s, const Cube& cube, const SortedItem* sorted, uint32_t count,
+                        const BuildItem* items, bool octants);
   void buildOctants(uint32_t sub, const Cube& cube, BuildItem* items, uint32_t count);
   /// Sorts the items by the child cube of `cube` holding their centres (counts and starts per
   /// octant), in place; the order within an octant is the build's (leaves keep it).
@@ -355,6 +374,7 @@ class OctoBvh {
   int rootLevel_ = octobvh::kMinLevel + 1;
   std::vector<uint32_t> mergeScratch_;  ///< mergeIntoLeaf's (edits are exclusive): no allocation per merge
   std::vector<BuildItem> buildScratch_; ///< buildFrom's and removeMany's items (kept when small)
+  std::vector<BuildItem> runScratch_;   ///< buildRunUnsorted's copy of a run's items
   const uint8_t* removing_ = nullptr;   ///< during removeMany: by handle, 1 for those it takes
   /// During bulkLoad: the build's items name input positions, and each element's record is
   /// allocated and written from the input when the build places it at its node.

@@ -433,8 +433,9 @@ TEST(EditLoadSplit, ADemolishedHouseSplitsTheSameForAnyThreadCount) {
   }
 }
 
-// A cut into two big halves: from kParallelPartBricks bricks on, the part's grid is built on
-// one thread while the old grid lets go on another. Any thread count gives the same grids (ids,
+// A cut into two big halves: from kParallelPartBricks bricks on, the part's index is built, its
+// bricks and mass added, the old grid lets go and the links move, as four jobs (the first two on
+// one grid: TSan checks they share nothing). Any thread count gives the same grids (ids,
 // index structure, mass) and the same state after the parts fall; mass is conserved.
 TEST(EditLoadSplit, ABigCutIsTheSameOnAnyThreadCountAndConservesMass) {
   SceneDescription scene;

@@ -97,7 +97,7 @@ const std::map<std::string, uint64_t> kRecordedHashes = {
     {"monument", 0x9f298662404df777ull},           {"plate_stack", 0x63c84db239f1dc84ull},
     {"stack10", 0x435561b2abd83ed3ull},            {"truck_in_station", 0xf5c05c4cc9dec175ull},
     {"ship_refit", 0xcb49a0d4ea30f8dfull},         {"demolition", 0xb64bb71788872444ull},
-    {"quarry", 0x12084c6f5463c5a6ull},            {"soak", 0x5b5def302dcecd52ull},
+    {"quarry", 0x7b148777089ca935ull},            {"soak", 0x5b5def302dcecd52ull},
     {"chain", 0x9e033f37e2d296f8ull},             {"docking", 0xf7cb68a120097719ull},
 };
 

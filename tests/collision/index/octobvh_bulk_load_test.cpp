@@ -123,6 +123,35 @@ TEST(OctoBvhBulkLoad, EveryHandleNamesItsInputAndTheTreeIsTheCanonicalOne) {
   }
 }
 
+// bulkLoad sorts elements by their first 19 levels of path below the root and leaves deeper
+// runs to the partitioning build (octobvh_sorted_build.cpp): tiny elements far from the origin
+// make trees 23+ levels deep, with forced nodes and duplicates on the way down.
+TEST(OctoBvhBulkLoad, TreesDeeperThanTheSortedLevelsAreTheCanonicalOnes) {
+  for (uint64_t seed : {11u, 12u, 13u}) {
+    SeededRandom r(seed);
+    const Vec3f far(float(1.5e5 * (seed == 12 ? -1 : 1)), 7.3e4f, -2.1e4f);
+    std::vector<Aabb> boxes;
+    for (int i = 0; i < 4000; ++i) {  // 2 m clusters of 3-50 mm boxes
+      const Vec3f c = far + Vec3f(float(r.unit() * 2), float(r.unit() * 2), float(r.unit() * 2)) + Vec3f::Constant(float(i % 4) * 40.f);
+      const float h = float(0.0015 + r.unit() * 0.024);
+      boxes.push_back({c - Vec3f::Constant(h), c + Vec3f(h, h * 0.5f, h)});
+    }
+    for (int i = 0; i < 40; ++i) {  // boxes of the same min level stacked at one point: forced down
+      const Vec3f c = far + Vec3f(0.5f, 0.5f, 0.5f);
+      boxes.push_back({c - Vec3f::Constant(0.3f + 0.001f * float(i)), c + Vec3f::Constant(0.3f)});
+    }
+    for (size_t i = boxes.size(); i > 1; --i) std::swap(boxes[i - 1], boxes[r.below(uint32_t(i))]);
+    const Inputs in = inputsOf(boxes);
+    OctoBvh bulk, inserted;
+    bulk.bulkLoad(in.bounds, in.filters, in.payloads);
+    bulk.validate();
+    for (uint32_t i = 0; i < in.bounds.size(); ++i) inserted.insert(in.bounds[i], in.filters[i], in.payloads[i]);
+    EXPECT_EQ(bulk.structureHash(), inserted.structureHash()) << "seed " << seed;
+    EXPECT_GT(bulk.shapeStats().depth, 19) << "seed " << seed << ": not deeper than the sorted levels";
+    EXPECT_GT(bulk.shapeStats().forcedNodes, 0u) << "seed " << seed;
+  }
+}
+
 // The point of writing records as the build places them: a leaf's elements, and the leaves
 // after one another, have ascending handles, so their records share and neighbour cache lines.
 TEST(OctoBvhBulkLoad, RecordsSitInThePoolInTheOrderTheBuildPlacesThem) {
