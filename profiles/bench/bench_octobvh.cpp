@@ -12,6 +12,10 @@
 // LoadLighthouse/<Index> and LoadLighthouseTiled/<Index>: the same workload on the real save
 // ../shared/data/Lighthouse_Island.brs (25,427 bricks) and on it tiled 10 x 10 (2,542,700 bricks,
 // the article's build size), bricks in file order, tile by tile.
+// BulkBuild/<Index>/<0 sparse 1M, 1 dense 1M, 2 lighthouse tiled>: an index of every brick at
+// once: OctoBVH::bulkLoad against the same tree inserted brick by brick (same_tree) and btDbvt's
+// inserts (insert_optimize_ms: then optimizeTopDown()); build_ms, ns_per_element (OctoBVH: best
+// of the iterations).
 // Edit/<Index>: insert, remove and update at 1M (ns per op); for OctoBVH also remove and update
 // by a loop that asks for each group of 32 edits' paths first (remove_prefetched_ns,
 // update_prefetched_ns: OctoBvh::prefetchPaths). Overlap2m/<Index>, RayClosest200m/<Index>,
@@ -416,6 +420,88 @@ void LoadLighthouseTiled_btDbvtOptimized(benchmark::State& s) { loadLighthouse<b
 
 constexpr uint32_t kMillion = 1'000'000;
 
+// ---------------------------------------------------------------- bulk builds
+
+// BulkBuild rows, arg 0 sparse 1M, 1 dense 1M, 2 the real lighthouse tiled (2.5M): an index of
+// every brick at once, as a grid is loaded or a part breaks off. OctoBVH::bulkLoad (one radix
+// sort of the bricks' paths, octobvh_sorted_build.cpp), the same tree by inserting one by one
+// (same_tree = 1 when the structure hashes agree), and Bullet's btDbvt as its users bulk-build
+// it: insert every leaf (as btCompoundShape does), then optionally optimizeTopDown().
+const std::vector<Aabb>* bulkBuildInput(benchmark::State& state, std::string& key) {
+  if (state.range(0) < 2) {
+    key = state.range(0) ? "dense" : "sparse";
+    return &build(kMillion, state.range(0) != 0);
+  }
+  key = "lighthouse_tiled";
+  std::string error;
+  const std::vector<Aabb>& bricks = lighthouseBuild(true, error);
+  if (!error.empty()) {
+    state.SkipWithError(error.c_str());
+    return nullptr;
+  }
+  return &bricks;
+}
+
+template <bool Bulk>
+void bulkBuildOctoBvh(benchmark::State& state, const char* name) {
+  std::string key;
+  const std::vector<Aabb>* b = bulkBuildInput(state, key);
+  if (!b) return;
+  const uint32_t n = uint32_t(b->size());
+  const std::vector<uint32_t> filters(n, 1u);
+  std::vector<uint32_t> payloads(n);
+  for (uint32_t i = 0; i < n; ++i) payloads[i] = i;
+  static std::map<std::string, uint64_t> hashes;  // by build: bulk-loaded and inserted agree
+  double best = 1e30;
+  uint64_t hash = 0, bytes = 0;
+  for (auto _ : state) {
+    bw::OctoBvh index(bw::OctoBvh::Config{n + 1024});
+    const auto t = Clock::now();
+    if constexpr (Bulk) {
+      index.bulkLoad(*b, filters, payloads);
+    } else {
+      for (uint32_t i = 0; i < n; ++i) index.insert((*b)[i], 1u, i);
+    }
+    const double s = secondsSince(t);
+    state.SetIterationTime(s);
+    best = std::min(best, s);
+    hash = index.structureHash();
+    bytes = index.memoryStats().totalBytes();
+  }
+  const auto [it, first] = hashes.emplace(key, hash);
+  state.counters["build_ms"] = best * 1e3;
+  state.counters["ns_per_element"] = best * 1e9 / n;
+  state.counters["bytes_per_element"] = double(bytes) / n;
+  state.counters["same_tree"] = first ? 1.0 : double(it->second == hash);
+  summary()[std::string("bulk_s_") + name + "_" + key] = best;
+}
+void BulkBuild_OctoBVH(benchmark::State& s) { bulkBuildOctoBvh<true>(s, "OctoBVH"); }
+void BulkBuild_OctoBVHInserted(benchmark::State& s) { bulkBuildOctoBvh<false>(s, "OctoBVHInserted"); }
+// note: the time is the inserts' (what btCompoundShape's own tree costs: it inserts each child);
+// insert_optimize_ms adds the optimizeTopDown() a user may call after a bulk build.
+void BulkBuild_btDbvt(benchmark::State& state) {
+  std::string key;
+  const std::vector<Aabb>* b = bulkBuildInput(state, key);
+  if (!b) return;
+  double insert = 0, optimize = 0;
+  for (auto _ : state) {
+    btDbvt tree;
+    const auto t = Clock::now();
+    for (const Aabb& box : *b) tree.insert(volume(box), nullptr);
+    insert = secondsSince(t);
+    state.SetIterationTime(insert);
+    const auto to = Clock::now();
+    tree.optimizeTopDown();
+    optimize = secondsSince(to);
+  }
+  state.counters["build_ms"] = insert * 1e3;
+  state.counters["insert_optimize_ms"] = (insert + optimize) * 1e3;
+  state.counters["ns_per_element"] = insert * 1e9 / double(b->size());
+  summary()[std::string("bulk_s_btDbvt_") + key] = insert;
+  summary()[std::string("bulk_s_btDbvtOptimized_") + key] = insert + optimize;
+}
+
+
 // Built by inserting the bricks one by one (handles, so records, in generation order), or for
 // the `BulkLoaded` rows by OctoBvh::bulkLoad (records in leaf order), as a grid is loaded from a file.
 template <class Index>
@@ -783,6 +869,14 @@ void printSummary() {
   auto& s = summary();
   auto get = [&](const std::string& k) { return s.count(k) ? s[k] : 0.0; };
   std::printf("\n== Comparisons (same run)\n");
+  for (const std::string key : {"sparse", "dense", "lighthouse_tiled"}) {
+    const double bulk = get("bulk_s_OctoBVH_" + key);
+    if (!bulk) continue;
+    std::printf("bulk build %s: OctoBVH bulkLoad %.1f ms; inserting one by one %.2fx its time, btDbvt inserts %.2fx, "
+                "btDbvt inserts + optimizeTopDown %.2fx\n",
+                key.c_str(), bulk * 1e3, get("bulk_s_OctoBVHInserted_" + key) / bulk, get("bulk_s_btDbvt_" + key) / bulk,
+                get("bulk_s_btDbvtOptimized_" + key) / bulk);
+  }
   for (const std::string key :
        {"100000", "1000000", "4000000", "100000_dense", "1000000_dense", "1000000_nolarge", "1000000_dense_nolarge",
         "lighthouse", "lighthouse_tiled"}) {
@@ -856,6 +950,9 @@ BENCHMARK(LoadWithoutLarge_LooseOctree)->Args({1'000'000, 0})->Args({1'000'000, 
 // btDbvt stops at 1M: its incremental load is superlinear here (1M took 48 s, 4M did not finish in 5 min).
 BENCHMARK(Load_btDbvt) BW_LOAD_SIZES->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(Load_btDbvtOptimized) BW_LOAD_SIZES->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BulkBuild_OctoBVH)->DenseRange(0, 2)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BulkBuild_OctoBVHInserted)->DenseRange(0, 2)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BulkBuild_btDbvt)->DenseRange(0, 2)->Iterations(1)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_OctoBVH)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_LooseOctree)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(LoadLighthouse_btDbvt)->Iterations(1)->Unit(benchmark::kMillisecond);
