@@ -13,8 +13,8 @@
 //   order, and the elements that stop at the node (its `big` ones) come first in its run (their
 //   key is the node's own prefix, zero-padded, with the smallest depth);
 // - so each node finds its held elements and its children's runs by searching its run, with
-//   nothing moved (an element's natural depth is in its key: the items themselves are read only
-//   to place them).
+//   nothing moved (an element's natural depth is in its key, and item i is input i: the items
+//   themselves are read only where build() takes over).
 // What the keys cannot order is left to build(): a node at depth kSortedLevels, and elements
 // forced below their natural depth (their key stops at the node that forces them down).
 // The tree is build()'s (structureHash equal, tested); inside a node, elements are listed in key
