@@ -395,25 +395,28 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   BrickGrid::Move move = old.prepareMove(part, *grid);
   const std::vector<uint32_t>& ids = move.newIds();
   std::unique_ptr<BrickConnectivity> partLinks;
-  // The part's index build, its bricks and mass, the old grid's bulk removal and the links'
-  // move touch four separate things: on two threads a big part costs about its build
-  // (Split_CutInTwo, 50k bricks: 17 -> 12 ms). note: tried before the removal gave its emptied
-  // pages back in runs (PoolIndexSpace::DeferPageRelease), this was slower than one thread: a
-  // madvise per emptied block, each flushing the TLB of the core that was building. The build
-  // goes first and the mass second: oneTBB's halves give one thread both while the other takes
-  // the removal and the links, and that thread is then free to take the mass from it.
+  // The part's index build, its bricks and mass, the old grid's bulk removal, its bricks and
+  // mass, and the links' move touch five separate things: on two threads a big part costs about
+  // its build (Split_CutInTwo, 50k bricks: 17 -> 12 ms). note: tried before the removal gave its
+  // emptied pages back in runs (PoolIndexSpace::DeferPageRelease), this was slower than one
+  // thread: a madvise per emptied block, each flushing the TLB of the core that was building.
+  // The build goes first and the part's mass second: oneTBB's halves give one thread both
+  // (33 + 15 M instructions for a 50k-brick half) while the other takes the old grid's two
+  // (24 + 18 M) and the links (9 M); with four threads or more the build alone is the longest.
+  constexpr uint32_t kSteps = 5;
   const auto step = [&](uint32_t k) {
     if (k == 0) grid->receiveMoveIndex(move);
     else if (k == 1) grid->receiveMoveBricks(move);
-    else if (k == 2) old.releaseMove(move);
+    else if (k == 2) old.releaseMoveIndex(move);
+    else if (k == 3) old.releaseMoveBricks(move);
     else partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   };
   if (part.size() >= tuning::kParallelPartBricks) {
-    jobs_.parallelFor(0, 4, 1, [&](uint32_t begin, uint32_t end) {
+    jobs_.parallelFor(0, kSteps, 1, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) step(k);
     });
   } else {
-    for (uint32_t k = 0; k < 4; ++k) step(k);
+    for (uint32_t k = 0; k < kSteps; ++k) step(k);
   }
   if (renderChunks_)  // the bricks as they were, now in the part's grid
     for (uint32_t id : ids) renderChunks_->removing(g, grid->brick(id));

@@ -173,8 +173,19 @@ void BrickGrid::receiveMoveBricks(Move& m) {
 }
 
 void BrickGrid::releaseMove(Move& m) {
+  releaseMoveIndex(m);
+  releaseMoveBricks(m);
+}
+
+void BrickGrid::releaseMoveIndex(Move& m) {
   BW_ASSERT(m.from_ == this);
-  index_.removeMany(m.elements_);  // (both give emptied pages back in runs)
+  index_.removeMany(m.elements_);  // (gives emptied pages back in runs)
+}
+
+// note: reads the bricks and the moments only (the moments' rebase walks the bricks left), never
+// the index, so it runs beside releaseMoveIndex.
+void BrickGrid::releaseMoveBricks(Move& m) {
+  BW_ASSERT(m.from_ == this);
   bricks_.freeMany(m.ids_);
   if (bricks_.size() == 0) {
     moments_.clear();

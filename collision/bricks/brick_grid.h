@@ -139,7 +139,8 @@ class BrickGrid {
   /// state is moveBricks'. Only an allocation failure can stop a step half way.
   /// receiveMove is itself two steps that touch separate state and may run at the same time:
   /// receiveMoveIndex (the index build, and each brick's element) and receiveMoveBricks (the
-  /// bricks and the grid's mass).
+  /// bricks and the grid's mass); releaseMove likewise is releaseMoveIndex (the bulk removal)
+  /// and releaseMoveBricks (the bricks and the mass).
   class Move {
    public:
     /// The bricks' ids in `into`, in the order of the ids moved (known once prepared).
@@ -158,8 +159,10 @@ class BrickGrid {
   void receiveMove(Move& move);
   void receiveMoveIndex(Move& move);
   void receiveMoveBricks(Move& move);
-  /// Called on the grid the bricks leave.
+  /// Called on the grid the bricks leave: releaseMoveIndex, then releaseMoveBricks.
   void releaseMove(Move& move);
+  void releaseMoveIndex(Move& move);
+  void releaseMoveBricks(Move& move);
   /// Counts edits; caches keyed on it are stale when it changes.
   uint64_t editCount() const { return edits_; }
 

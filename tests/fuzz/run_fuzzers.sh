@@ -4,7 +4,7 @@
 # as crash-*/leak-*/timeout-*/oom-* in the working folder: copy it into tests/fuzz/corpus/<target>
 # as a regression case once fixed).
 #   tests/fuzz/run_fuzzers.sh SECONDS [TARGET...]     (default: every target)
-#   FUZZ_SEED=1 tests/fuzz/run_fuzzers.sh 60           (CI: a fixed seed and run count, the same inputs every run)
+#   FUZZ_SEED=1 tests/fuzz/run_fuzzers.sh 30           (CI: a fixed seed and run count, the same inputs every run)
 # Two targets run at once on a machine with two or more cores. Corpora grow in build/fuzz/corpus.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -27,19 +27,22 @@ run_one() {
   local opts=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -print_final_stats=1
               -artifact_prefix=build/fuzz/findings/"$t"/)
   [ -f tests/fuzz/"$t".dict ] && opts+=(-dict=tests/fuzz/"$t".dict)
-  # CI: a fixed seed and a fixed number of runs per target (about 60 s each here), so every CI
-  # run tries the same inputs: a pass here is a pass there (a slower machine stops at the time
-  # cap first, trying a prefix of the same inputs). Findings come from the long random runs.
+  # CI: a fixed seed and a fixed number of runs per target (each count about 60 s here, scaled
+  # to the seconds given), so every CI run tries the same inputs: a pass here is a pass there (a
+  # slower machine stops at the time cap first, trying a prefix of the same inputs). Findings
+  # come from the long random runs.
   if [ -n "${FUZZ_SEED:-}" ]; then
     opts+=(-seed="$FUZZ_SEED")
+    local per_minute
     case $t in
-      brs) opts+=(-runs=30000) ;;
-      vox) opts+=(-runs=800000) ;;
-      scene) opts+=(-runs=40000) ;;
-      octobvh_edits) opts+=(-runs=12000) ;;
-      grid_edits) opts+=(-runs=7000) ;;
-      broadphase) opts+=(-runs=10000) ;;
+      brs) per_minute=30000 ;;
+      vox) per_minute=800000 ;;
+      scene) per_minute=40000 ;;
+      octobvh_edits) per_minute=12000 ;;
+      grid_edits) per_minute=7000 ;;
+      broadphase) per_minute=10000 ;;
     esac
+    opts+=(-runs=$(( per_minute * seconds / 60 )))
   fi
   # the real content files are large: only their first 64 KiB seed the byte targets
   case $t in brs|vox) opts+=(-max_len=65536) ;; esac

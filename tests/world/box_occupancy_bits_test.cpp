@@ -49,7 +49,9 @@ TEST(BoxOccupancyBits, NeverSaysNoWhereABoxOverlaps) {
         query.min[a] = b.min[a] - h[a];
       }
       if (q % 7 == 3) std::swap(query.min, query.max);  // inverted
-      if (anyOverlap(boxes, query)) ASSERT_TRUE(bits.mayOverlap(query)) << "round " << round << ", query " << q;
+      if (anyOverlap(boxes, query)) {
+        ASSERT_TRUE(bits.mayOverlap(query)) << "round " << round << ", query " << q;
+      }
     }
     WorldAabb nan{Vec3d::Constant(std::numeric_limits<double>::quiet_NaN()), origin};
     EXPECT_FALSE(bits.mayOverlap(nan));  // WorldAabb::overlaps says no for NaN too
@@ -76,7 +78,9 @@ TEST(BoxOccupancyBits, SaysNoToMostQueriesThatMeetNothingAmongSparseBoxes) {
     const Vec3d c = at();
     const WorldAabb query{c - Vec3d::Constant(0.6), c + Vec3d::Constant(0.6)};
     const bool any = anyOverlap(boxes, query), may = bits.mayOverlap(query);
-    if (any) ASSERT_TRUE(may) << "query " << q;
+    if (any) {
+      ASSERT_TRUE(may) << "query " << q;
+    }
     empty += any ? 0 : 1;
     saidNo += may ? 0 : 1;
   }

@@ -135,7 +135,9 @@ TEST(EditLoad, PlacementsChosenTogetherNeverTakeTheSameSpot) {
   const auto all = liveBricks(*grids[0]);
   for (const auto& [id, brick] : all)
     for (const auto& [other, o] : all)
-      if (other > id) ASSERT_FALSE(overlaps(brick, o)) << "bricks " << id << " and " << other;
+      if (other > id) {
+        ASSERT_FALSE(overlaps(brick, o)) << "bricks " << id << " and " << other;
+      }
 }
 
 TEST(EditLoad, CarvedHolesAreExactlyTheBricksWithinTheRadiusOfOneBrick) {

@@ -135,7 +135,9 @@ TEST(DynamicBoundsTree, RefitsLoosenWithoutLosingAnythingAndSelfPairsMatchBruteF
           for (uint32_t j = i + 1; j < n; ++j)
             if (boxes[i].overlaps(boxes[j]) && (!filtered || wanted[i] || wanted[j])) expected.push_back({i, j});
         ASSERT_EQ(got, expected) << "round " << round << (filtered ? ", filtered" : "") << ", offset " << offset;
-        if (!filtered) EXPECT_GT(got.size(), 1000u);
+        if (!filtered) {
+          EXPECT_GT(got.size(), 1000u);
+        }
       }
       for (int q = 0; q < 40; ++q) {
         const WorldAabb box = randomBox(r, origin, 150);

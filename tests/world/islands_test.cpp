@@ -72,7 +72,9 @@ TEST(Islands, ParallelUnionFindEqualsSerialForAnyThreadCount) {
         ASSERT_FALSE(islands.contacts(is).empty());
         const uint32_t root = rootOf(islands.contacts(is)[0]);
         for (uint32_t k : islands.contacts(is)) ASSERT_EQ(rootOf(k), root);
-        if (is > 0) ASSERT_LT(rootOf(islands.contacts(is - 1)[0]), root);
+        if (is > 0) {
+          ASSERT_LT(rootOf(islands.contacts(is - 1)[0]), root);
+        }
       }
     }
   }

@@ -110,8 +110,12 @@ void expectShapeMatches(const btCollisionShape* s, const Brick& b, const char* w
     int onPlane = 0;
     for (int k = 0; k < vertices; ++k) onPlane += std::abs(planes[i].n.dot(v[k]) - planes[i].d) <= tolerance ? 1 : 0;
     EXPECT_LE(reach, planes[i].d + tolerance) << where << ": plane " << i;
-    if (onPlane >= 3) EXPECT_GE(reach, planes[i].d - margin - tolerance) << where << ": face " << i;
-    if (planes[i].n.z() < -0.999f) EXPECT_NEAR(reach, planes[i].d, tolerance) << where << ": bottom face";
+    if (onPlane >= 3) {
+      EXPECT_GE(reach, planes[i].d - margin - tolerance) << where << ": face " << i;
+    }
+    if (planes[i].n.z() < -0.999f) {
+      EXPECT_NEAR(reach, planes[i].d, tolerance) << where << ": bottom face";
+    }
     for (int k = 0; k < hull->getNumPoints(); ++k)
       EXPECT_LE(hull->getUnscaledPoints()[k].dot(normal), planes[i].d - margin + tolerance) << where << ": point " << k << " face " << i;
   }

@@ -284,7 +284,9 @@ TEST(VirtualPool, FreeManyRefusesADeadOrRepeatedHandleWhole) {
     }
     EXPECT_EQ(pool.size(), 299u) << "nothing freed";
     for (uint32_t h : handles)
-      if (h != ids[7] && h < 1000) EXPECT_TRUE(pool.isLive(h) && pool[h].holds(h));
+      if (h != ids[7] && h < 1000) {
+        EXPECT_TRUE(pool.isLive(h) && pool[h].holds(h));
+      }
   };
   refused({ids[1], ids[2], ids[7], ids[3]}, "not a live element");
   refused({ids[1], ids[2], ids[1]}, "listed twice");

@@ -118,7 +118,9 @@ TEST(OctoBvhBulkLoad, EveryHandleNamesItsInputAndTheTreeIsTheCanonicalOne) {
         if ((in.filters[i] & mask) && intersectRayAabb(ray, in.bounds[i], 0.f, ray.maxT, t)) best = std::min(best, t);
       }
       ASSERT_EQ(hit.hit(), std::isfinite(best)) << "seed " << k.seed << ", ray " << q;
-      if (hit.hit()) EXPECT_EQ(hit.t, best) << "seed " << k.seed << ", ray " << q;
+      if (hit.hit()) {
+        EXPECT_EQ(hit.t, best) << "seed " << k.seed << ", ray " << q;
+      }
     }
   }
 }
