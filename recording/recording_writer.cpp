@@ -153,7 +153,7 @@ void RecordingWriter::writeGrid(const World& world, uint32_t g) {
   s.put(grid.brickCount());
   s.put(uint32_t(bricks ? grid.brickCount() : 0));
   if (mirrors_.size() <= g) mirrors_.resize(g + 1);
-  mirrors_[g] = Mirror{.kept = bricks};
+  mirrors_[g] = Mirror{.kept = bricks, .bricks = {}, .live = {}};
   if (bricks)
     grid.forEachBrick([&](uint32_t id) {
       s.put(id);

@@ -49,7 +49,7 @@ class SceneComponent {
                                    TransformUpdateSink& sink) = 0;
 
  private:
-  ComponentColdState cold_{};
+  [[maybe_unused]] ComponentColdState cold_{};  // never read: the weight it puts in the cache is the point
   SceneComponent* parent_;
   std::vector<SceneComponent*> children_;
   uint32_t body_;

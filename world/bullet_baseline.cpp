@@ -397,8 +397,10 @@ BulletBaseline::BulletBaseline(const World& w, BulletSetup setup, float chunkSiz
         if (motion == MotionType::Static || (motion == MotionType::Kinematic && kinematic == KinematicGrids::ChunkBodies)) {
           // One object per chunk: a pair walks one chunk's children, not the grid's. A
           // kinematic grid's chunks as kinematic bodies moved together (KinematicGrids).
-          m.objectHolders.push_back({g, bt(b.shapePose(i)), m.friction(b.friction[i]), {}});
-          Impl::ObjectHolder& h = m.objectHolders.back();
+          Impl::ObjectHolder& h = m.objectHolders.emplace_back();
+          h.grid = g;
+          h.pose = bt(b.shapePose(i));
+          h.friction = m.friction(b.friction[i]);
           if (motion == MotionType::Kinematic) {
             h.kinematic = true;
             h.body = i;

@@ -264,6 +264,15 @@ bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f
 
 namespace {
 
+// Sorts the few (at most 16) corners of one pair: an insertion sort, which puts equal keys in
+// the order std::sort gives so few (libstdc++ sorts up to 16 elements by insertion); std::sort
+// on these 8-element arrays trips GCC 12's -Warray-bounds at -O3, a false positive.
+template <class T, class Less>
+void sortSmall(T* items, int count, Less less) {
+  for (int i = 1; i < count; ++i)
+    for (int j = i; j > 0 && less(items[j], items[j - 1]); --j) std::swap(items[j], items[j - 1]);
+}
+
 // A speculative (separated) box-box contact from GJK is one closest point, and a tilted box that
 // just touches has one or two. A tilted box closing on a thin plate faster than its size per
 // step then has one contact: the solver stops that corner and the box turns about it, so its far
@@ -293,7 +302,7 @@ int addSpeculativeCorners(const Vec3f& halfA, const btTransform& trA, const Vec3
     if (std::any_of(out, out + count, [&](const LocalContact& c) { return (c.position - onFace).norm() < slack; })) continue;
     corners[found++] = {gap, onFace};
   }
-  std::sort(corners, corners + found, [](const Corner& x, const Corner& y) { return x.gap < y.gap; });
+  sortSmall(corners, found, [](const Corner& x, const Corner& y) { return x.gap < y.gap; });  // nearest first
   for (int i = 0; i < found && count < kMaxContactsPerBrick; ++i)
     out[count++] = {corners[i].point, n, -corners[i].gap, out[0].feature, out[0].material};
   return count;
@@ -373,7 +382,7 @@ int addBoxCorners(const Vec3f& half, const btTransform& trBox, const Brick& bric
     if (std::any_of(out, out + count, [&](const LocalContact& o) { return (o.position - onFace).norm() < tolerance; })) continue;
     corners[found++] = {onFace, n, -gap, out[0].feature, out[0].material, uint8_t(1 + i)};
   }
-  std::sort(corners, corners + found, [](const LocalContact& x, const LocalContact& y) { return x.depth > y.depth; });
+  sortSmall(corners, found, [](const LocalContact& x, const LocalContact& y) { return x.depth > y.depth; });
   for (int i = 0; i < found && count < kMaxContactsPerBrick; ++i) out[count++] = corners[i];
   return count;
 }

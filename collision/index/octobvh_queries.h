@@ -74,10 +74,12 @@ inline unsigned overlapMaskPortable(const octobvh::NodeCluster& ch, const Aabb& 
   unsigned hits = 0, cand = 0;
   for (int o = 0; o < 8; ++o) {
     const bool match = (ch.filter[o] & mask) != 0;
-    const bool ov = (ch.minX[o] <= box.max.x()) & (ch.maxX[o] >= box.min.x()) & (ch.minY[o] <= box.max.y()) &
-                    (ch.maxY[o] >= box.min.y()) & (ch.minZ[o] <= box.max.z()) & (ch.maxZ[o] >= box.min.z());
+    // note: `&` on 0/1 values, not `&&`: no branch per axis (clang warns on `&` between bools).
+    const unsigned ov = unsigned(ch.minX[o] <= box.max.x()) & unsigned(ch.maxX[o] >= box.min.x()) &
+                        unsigned(ch.minY[o] <= box.max.y()) & unsigned(ch.maxY[o] >= box.min.y()) &
+                        unsigned(ch.minZ[o] <= box.max.z()) & unsigned(ch.maxZ[o] >= box.min.z());
     cand |= unsigned(match) << o;
-    hits |= unsigned(match & ov) << o;
+    hits |= (unsigned(match) & ov) << o;
   }
   candidates = cand;
   return hits;

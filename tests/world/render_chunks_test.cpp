@@ -96,7 +96,7 @@ Brick randomBrick(std::mt19937& rng, const Vec3f& origin, float spread) {
 }
 
 TEST(RenderChunks, FollowRandomEditsExactlyAndReuseHiddenChunks) {
-  for (const Vec3f origin : {Vec3f(0, 0, 0), Vec3f(3e4f, -2e4f, 500.f)}) {
+  for (const Vec3f& origin : {Vec3f(0, 0, 0), Vec3f(3e4f, -2e4f, 500.f)}) {
     for (uint32_t seed : {1u, 2u, 3u}) {
       std::mt19937 rng(seed);
       const float chunk = seed == 3 ? 0.5f : 4.f;

@@ -51,7 +51,9 @@ TEST(TerrainBreak, CarvedQuarryLosesExactlyWhatBrokeFreeAndEachPartWeighsItsVoxe
     }
     ASSERT_GT(parts, 2u) << "the carves must cut regions free for this test to mean anything";
     EXPECT_EQ(world.bodies().size(), bodiesBefore + parts);
-    if (debris == 0) EXPECT_EQ(debrisVoxels, 0u);
+    if (debris == 0) {
+      EXPECT_EQ(debrisVoxels, 0u);
+    }
     // Each part's grid weighs its voxels (density 1, 0.125 m^3 a voxel); all together they,
     // the carved voxels and the debris are what the terrain lost.
     uint64_t partVoxels = 0;
