@@ -22,6 +22,7 @@
 #include "collision/core/argument_checks.h"
 #include "collision/core/seeded_random.h"
 #include "collision/support/extremes_support.h"
+#include "collision/support/sequenced_draws.h"
 
 namespace bw {
 namespace {
@@ -58,8 +59,10 @@ std::vector<LocalQuery> farQueries(std::vector<Vec3f>& hullPoints) {
   out.push_back({QueryShape::box(Vec3f(0.05f, 0.05f, 0.05f)), Vec3f(1.1f, 6.f, 0.14f + 0.05f - 0.004f), Quatf::Identity()});
   SeededRandom r(51);
   for (int k = 0; k < 40; ++k) {
-    const Vec3f p(float(r.uniform(0, 7)), float(r.uniform(0, 7)), float(r.uniform(0.05, 1.2)));
-    const Quatf q(Eigen::AngleAxisf(float(r.uniform(0, 6.28)), Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized()));
+    // Draws in a fixed order (collision/support/sequenced_draws.h).
+    const Vec3f p = drawVec3([&](int axis) { return axis < 2 ? r.uniform(0, 7) : r.uniform(0.05, 1.2); });
+    const Vec3f axis = drawVec3([&](int) { return r.normal(); }).normalized();
+    const Quatf q(Eigen::AngleAxisf(float(r.uniform(0, 6.28)), axis));
     switch (k % 4) {
       case 0: out.push_back({QueryShape::sphere(0.3f), p, q}); break;
       case 1: out.push_back({QueryShape::box(Vec3f(0.4f, 0.3f, 0.2f)), p, q}); break;
@@ -152,8 +155,8 @@ TEST(ExtremesFarFromOrigin, GridPlacedUpTo1e9AnswersLikeAtTheOrigin) {
   SeededRandom r(52);
   std::vector<Ray> rays;
   for (int k = 0; k < 200; ++k) {
-    const Vec3f o(float(r.uniform(-2, 9)), float(r.uniform(-2, 9)), float(r.uniform(1.5, 4)));
-    const Vec3f target(float(r.uniform(0, 7)), float(r.uniform(0, 7)), float(r.uniform(0, 1)));
+    const Vec3f o = drawVec3([&](int axis) { return axis < 2 ? r.uniform(-2, 9) : r.uniform(1.5, 4); });
+    const Vec3f target = drawVec3([&](int axis) { return axis < 2 ? r.uniform(0, 7) : r.uniform(0, 1); });
     rays.push_back(Ray::make(o, (target - o).normalized()));
   }
   std::vector<GridRayHit> refHits;
@@ -161,8 +164,9 @@ TEST(ExtremesFarFromOrigin, GridPlacedUpTo1e9AnswersLikeAtTheOrigin) {
   std::vector<Aabb> boxes;
   std::vector<std::vector<uint32_t>> refOverlaps;
   for (int k = 0; k < 100; ++k) {
-    boxes.push_back(Aabb::fromCenterHalf(Vec3f(float(r.uniform(-1, 8)), float(r.uniform(-1, 8)), float(r.uniform(-0.5, 1.5))),
-                                         Vec3f::Constant(float(r.logUniform(0.01, 2)))));
+    const float half = float(r.logUniform(0.01, 2));
+    const Vec3f centre = drawVec3([&](int axis) { return axis < 2 ? r.uniform(-1, 8) : r.uniform(-0.5, 1.5); });
+    boxes.push_back(Aabb::fromCenterHalf(centre, Vec3f::Constant(half)));
     refOverlaps.emplace_back();
     grid.overlapBricks(boxes.back(), ~0u, refOverlaps.back());
     std::sort(refOverlaps.back().begin(), refOverlaps.back().end());
@@ -241,8 +245,8 @@ TEST(ExtremesFarFromOrigin, BricksAtLocal1e4KeepFloatSpacingPrecision) {
   SeededRandom r(53);
   float rayDiff = 0;
   for (int k = 0; k < 200; ++k) {
-    const Vec3f o(float(r.uniform(-2, 9)), float(r.uniform(-2, 9)), float(r.uniform(1.5, 4)));
-    const Vec3f target(float(r.uniform(0, 7)), float(r.uniform(0, 7)), float(r.uniform(0, 1)));
+    const Vec3f o = drawVec3([&](int axis) { return axis < 2 ? r.uniform(-2, 9) : r.uniform(1.5, 4); });
+    const Vec3f target = drawVec3([&](int axis) { return axis < 2 ? r.uniform(0, 7) : r.uniform(0, 1); });
     const Vec3f d = (target - o).normalized();
     const GridRayHit h0 = near.raycast(Ray::make(o, d), ~0u);
     const GridRayHit h1 = far.raycast(Ray::make(o + offset, d), ~0u);

@@ -16,6 +16,7 @@
 
 #include "collision/bricks/brick_narrowphase.h"
 #include "collision/core/seeded_random.h"
+#include "collision/support/sequenced_draws.h"
 
 namespace bw {
 namespace {
@@ -29,13 +30,10 @@ constexpr float kNormalTol = 1e-3f;  // |normal - expected|
 constexpr float kEpaNormalTol = 3e-2f;
 constexpr float kEpaPointRel = 1e-2f;
 
-Quatf randomRotation(SeededRandom& r) {
-  return Quatf(float(r.normal()), float(r.normal()), float(r.normal()), float(r.normal())).normalized();
-}
-Vec3f randomUnit(SeededRandom& r) { return Vec3f(float(r.normal()), float(r.normal()), float(r.normal())).normalized(); }
-Vec3f randomPosition(SeededRandom& r, float scale) {
-  return Vec3f(float(r.uniform(-1, 1)), float(r.uniform(-1, 1)), float(r.uniform(-1, 1))) * scale;
-}
+// Draws in a fixed order (collision/support/sequenced_draws.h).
+Quatf randomRotation(SeededRandom& r) { return test::drawQuat([&] { return r.normal(); }).normalized(); }
+Vec3f randomUnit(SeededRandom& r) { return test::drawVec3([&](int) { return r.normal(); }).normalized(); }
+Vec3f randomPosition(SeededRandom& r, float scale) { return test::drawVec3([&](int) { return r.uniform(-1, 1); }) * scale; }
 
 struct Worst {
   const char* name;
@@ -58,8 +56,9 @@ TEST(ShapeContacts, SphereSphereMatchesClosedForm) {
     const Vec3f pa = pb + n * (ra + rb - depth);
     const float margin = 0.1f * std::min(ra, rb);
     LocalContact c[kMaxContactsPerBrick];
-    const int m = collideShapes(QueryShape::sphere(ra), {pa, randomRotation(r)}, QueryShape::sphere(rb), {pb, randomRotation(r)},
-                                margin, c);
+    // b's rotation first: GCC's order when both were call arguments (collision/support/sequenced_draws.h)
+    const Quatf rotationB = randomRotation(r), rotationA = randomRotation(r);
+    const int m = collideShapes(QueryShape::sphere(ra), {pa, rotationA}, QueryShape::sphere(rb), {pb, rotationB}, margin, c);
     ASSERT_EQ(m, 1) << "case " << k << " depth " << depth;
     const Vec3f expectedPoint = pb + n * rb;
     const float dErr = std::abs(c[0].depth - depth) / size, pErr = (c[0].position - expectedPoint).norm() / size,
@@ -92,7 +91,7 @@ TEST(ShapeContacts, SphereBoxMatchesClosedFormInFaceEdgeAndCornerRegions) {
   // accurate; at most 0.5% of the 3000 pairs may miss kEpaNormalTol, and they are printed.
   int normalOutliers = 0;
   for (int k = 0; k < 1500; ++k) {
-    const Vec3f h(float(r.logUniform(0.2, 500)), float(r.logUniform(0.2, 500)), float(r.logUniform(0.2, 500)));
+    const Vec3f h = test::drawVec3([&](int) { return r.logUniform(0.2, 500); });
     const LocalPose box{randomPosition(r, 100), randomRotation(r)};
     // A centre outside the box: pick a region (1..3 clamped axes), then offsets.
     const int clamped = 1 + int(r.below(3));
@@ -100,8 +99,12 @@ TEST(ShapeContacts, SphereBoxMatchesClosedFormInFaceEdgeAndCornerRegions) {
     const uint32_t first = r.below(3);
     for (int a = 0; a < 3; ++a) {
       const bool out = (int((uint32_t(a) + 3 - first) % 3) < clamped);
-      local[a] = out ? (r.below(2) ? 1.f : -1.f) * h[a] * float(1 + r.uniform(0.05, 0.5))
-                     : h[a] * float(r.uniform(-0.9, 0.9));
+      if (out) {
+        const float sign = r.below(2) ? 1.f : -1.f;
+        local[a] = sign * h[a] * float(1 + r.uniform(0.05, 0.5));
+      } else {
+        local[a] = h[a] * float(r.uniform(-0.9, 0.9));
+      }
     }
     const Vec3f centre = box.position + box.rotation * local;
     const Vec3f q = closestOnBox(h, box, centre);
@@ -155,7 +158,7 @@ TEST(ShapeContacts, BoxOnBoxFaceGivesItsFourCornersAtTheRightDepth) {
   // world's speculative margin for boxes comes through collideShapeBrick's same path.
   int hoverMisses = 0;  // hovering pairs whose GJK normal is off by more than 1e-2 (seen: 0.046)
   for (int k = 0; k < 800; ++k) {
-    const Vec3f hb(float(r.logUniform(0.5, 500)), float(r.logUniform(0.5, 500)), float(r.logUniform(0.2, 500)));
+    const Vec3f hb = test::drawVec3([&](int axis) { return axis < 2 ? r.logUniform(0.5, 500) : r.logUniform(0.2, 500); });
     const LocalPose b{randomPosition(r, 100), randomRotation(r)};
     // a's footprint (its circumradius) fits inside b's face whatever the yaw.
     const float footprint = std::min(hb.x(), hb.y()) * float(r.uniform(0.2, 0.45));
@@ -172,8 +175,9 @@ TEST(ShapeContacts, BoxOnBoxFaceGivesItsFourCornersAtTheRightDepth) {
         hovering ? -(float(r.uniform(0.001, 0.05)) * thin + 1e-4f * size) : float(r.uniform(0.01, 0.2)) * thin;
     const float margin = hovering ? -2.f * depth : 0.f;
     hovered += hovering;
-    const Vec3f offset(float(r.uniform(-0.5, 0.5)) * (hb.x() - footprint), float(r.uniform(-0.5, 0.5)) * (hb.y() - footprint),
-                       hb.z() + ha.z() - depth);
+    const float offsetY = float(r.uniform(-0.5, 0.5)) * (hb.y() - footprint);
+    const float offsetX = float(r.uniform(-0.5, 0.5)) * (hb.x() - footprint);
+    const Vec3f offset(offsetX, offsetY, hb.z() + ha.z() - depth);
     const Quatf yaw(Eigen::AngleAxisf(float(r.uniform(0, 6.2831853)), Vec3f::UnitZ()));
     const LocalPose a{b.position + b.rotation * offset, (b.rotation * yaw).normalized()};
     LocalContact c[kMaxContactsPerBrick];
@@ -241,15 +245,16 @@ TEST(ShapeContacts, CapsuleOnBoxFaceStandingAndLyingMatchesClosedForm) {
     const float radius = float(r.logUniform(0.2, 250)), halfHeight = float(r.logUniform(0.2, 250));
     const bool lying = k % 2 == 1;
     const float reach = lying ? halfHeight + radius : radius;  // footprint's half length on the face
-    const Vec3f hb(reach * float(r.uniform(1.2, 3)), reach * float(r.uniform(1.2, 3)), float(r.logUniform(0.2, 500)));
+    const Vec3f hb = test::drawVec3([&](int axis) { return axis < 2 ? reach * float(r.uniform(1.2, 3)) : r.logUniform(0.2, 500); });
     const LocalPose b{randomPosition(r, 100), randomRotation(r)};
     const float size = std::max({radius, halfHeight, hb.maxCoeff()});
     const bool hovering = r.below(4) == 0;
     const float thin = std::min(radius, hb.z());
     const float depth = hovering ? -float(r.uniform(0.001, 0.05)) * thin : float(r.uniform(0.01, 0.5)) * thin;
     const float margin = hovering ? -2.f * depth : 0.f;
-    const Vec3f offset(float(r.uniform(-0.9, 0.9)) * (hb.x() - reach), float(r.uniform(-0.9, 0.9)) * (hb.y() - reach),
-                       hb.z() + radius - depth + (lying ? 0.f : halfHeight));
+    const float offsetY = float(r.uniform(-0.9, 0.9)) * (hb.y() - reach);
+    const float offsetX = float(r.uniform(-0.9, 0.9)) * (hb.x() - reach);
+    const Vec3f offset(offsetX, offsetY, hb.z() + radius - depth + (lying ? 0.f : halfHeight));
     const float theta = float(r.uniform(0, 6.2831853));
     Quatf local(Eigen::AngleAxisf(theta, Vec3f::UnitZ()));
     if (lying) local = local * Quatf(Eigen::AngleAxisf(1.5707963f, Vec3f::UnitX()));  // axis along the face
