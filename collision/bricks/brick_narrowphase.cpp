@@ -264,9 +264,9 @@ bool sweepShapeBrick(const QueryShape& shape, const Quatf& rotation, const Vec3f
 
 namespace {
 
-// Sorts the few (at most 16) corners of one pair: an insertion sort, which puts equal keys in
-// the order std::sort gives so few (libstdc++ sorts up to 16 elements by insertion); std::sort
-// on these 8-element arrays trips GCC 12's -Warray-bounds at -O3, a false positive.
+// Sorts one pair's few corners (at most 8) by insertion, which leaves equal keys where std::sort
+// did (libstdc++ sorts up to 16 elements by insertion: the state hashes are unchanged);
+// std::sort on these arrays trips GCC 12's -Warray-bounds at -O3, a false positive.
 template <class T, class Less>
 void sortSmall(T* items, int count, Less less) {
   for (int i = 1; i < count; ++i)
