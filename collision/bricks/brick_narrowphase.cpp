@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "collision/bricks/box_box_gap.h"
 #include "collision/bricks/brick_geometry.h"
 #include "collision/core/argument_checks.h"
 
@@ -19,6 +20,12 @@ namespace {
 
 btVector3 bt(const Vec3f& v) { return {v.x(), v.y(), v.z()}; }
 Vec3f fromBt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+Mat3f fromBt(const btMatrix3x3& m) {
+  Mat3f r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r(i, j) = m[i][j];
+  return r;
+}
 
 btTransform brickTransform(const Brick& b) {
   btMatrix3x3 m;
@@ -273,38 +280,65 @@ void sortSmall(T* items, int count, Less less) {
     for (int j = i; j > 0 && less(items[j], items[j - 1]); --j) std::swap(items[j], items[j - 1]);
 }
 
-// A speculative (separated) box-box contact from GJK is one closest point, and a tilted box that
+// A speculative (separated) box-box contact is one nearest pair of points, and a tilted box that
 // just touches has one or two. A tilted box closing on a thin plate faster than its size per
 // step then has one contact: the solver stops that corner and the box turns about it, so its far
-// corners swing through the plate within the step. The box's other corners facing the brick
-// within the margin get their own contacts (each with its own gap along the first contact's
-// normal) while their projection lies on the brick's box, so the whole face is held back.
-// Appends to out[0, count); returns the new count (at most kMaxContactsPerBrick).
+// corners swing through the plate within the step. So the other corners facing a face across the
+// gap within the margin get their own contacts, each with its own gap along the first contact's
+// normal: a's corners over b's face, and b's corners under a's face (a small brick under a large
+// box, or a row of small bricks flying at a wall: with one contact each, at the same corner of
+// every brick, the row turned about that line into the wall). Nearest first. Appends to
+// out[0, count); returns the new count (at most kMaxContactsPerBrick).
 int addSpeculativeCorners(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB, const btTransform& trB, float margin,
                           LocalContact* out, int count) {
-  const Vec3f n = out[0].normal, onBrick = out[0].position;  // on b's face
+  const Vec3f n = out[0].normal, onB = out[0].position;  // from b to a; on b
+  const Vec3f onA = onB - n * out[0].depth;               // on a (depth = -gap)
   struct Corner {
     float gap;
-    Vec3f point;
+    Vec3f point;  // on b
   };
-  Corner corners[8];
+  Corner corners[16];
   int found = 0;
-  for (int i = 0; i < 8; ++i) {
-    const Vec3f local((i & 1) ? halfA.x() : -halfA.x(), (i & 2) ? halfA.y() : -halfA.y(), (i & 4) ? halfA.z() : -halfA.z());
-    const Vec3f v = fromBt(trA * bt(local));
-    const float gap = (v - onBrick).dot(n);
-    if (gap >= margin || gap < 0.f) continue;  // out of reach, or penetrating (the detector's)
-    const Vec3f onFace = v - n * gap;
-    // On b's box (a little slack for rounding)?
-    const Vec3f inB = fromBt(trB.invXform(bt(onFace)));
-    if ((inB.cwiseAbs().array() > halfB.array() + 1e-3f * (1.f + halfB.maxCoeff())).any()) continue;
-    const float slack = 1e-3f * (1.f + halfA.maxCoeff());
-    if (std::any_of(out, out + count, [&](const LocalContact& c) { return (c.position - onFace).norm() < slack; })) continue;
-    corners[found++] = {gap, onFace};
-  }
+  // The corners of one box facing the other's face across the gap: only when the normal is a
+  // face normal of the other (within 1 degree), as that face is then the plane the corners face,
+  // through the other's nearest point; each corner's gap is measured along the normal to it, and
+  // its projection must lie on the face. (Across an edge or a corner, the plane across the normal
+  // is not the other's surface: a corner given a gap to it could go into it.) `toFace` is the
+  // direction from the corners towards the face.
+  auto facing = [&](const Vec3f& half, const btTransform& tr, const Vec3f& faceHalf, const btTransform& faceTr,
+                    const Vec3f& onFace, const Vec3f& toFace, bool cornersOnB) {
+    const btMatrix3x3& basis = faceTr.getBasis();
+    int axis = 0;
+    float alignment = 0.f;
+    for (int k = 0; k < 3; ++k) {
+      const float d = std::abs(toFace.dot(fromBt(basis.getColumn(k))));
+      if (d > alignment) alignment = d, axis = k;
+    }
+    if (!(alignment > 0.99985f)) return;
+    const Vec3f m = fromBt(basis.getColumn(axis)) * (toFace.dot(fromBt(basis.getColumn(axis))) > 0.f ? 1.f : -1.f);
+    const float slack = 1e-3f * (1.f + std::min(halfA.maxCoeff(), halfB.maxCoeff()));
+    for (int i = 0; i < 8; ++i) {
+      const Vec3f local((i & 1) ? half.x() : -half.x(), (i & 2) ? half.y() : -half.y(), (i & 4) ? half.z() : -half.z());
+      const Vec3f v = fromBt(tr * bt(local));
+      const float gap = (onFace - v).dot(m) / toFace.dot(m);
+      if (gap >= margin || gap < 0.f) continue;  // out of reach, or penetrating (the detector's)
+      const Vec3f projected = v + toFace * gap;
+      const Vec3f inFace = fromBt(faceTr.invXform(bt(projected)));
+      if ((inFace.cwiseAbs().array() > faceHalf.array() + 1e-3f * (1.f + faceHalf.maxCoeff())).any()) continue;
+      const Vec3f point = cornersOnB ? v : projected;
+      if (std::any_of(out, out + count, [&](const LocalContact& c) { return (c.position - point).norm() < slack; })) continue;
+      corners[found++] = {gap, point};
+    }
+  };
+  facing(halfA, trA, halfB, trB, onB, -n, false);  // a's corners onto b's face
+  facing(halfB, trB, halfA, trA, onA, n, true);    // b's corners onto a's face
   sortSmall(corners, found, [](const Corner& x, const Corner& y) { return x.gap < y.gap; });  // nearest first
-  for (int i = 0; i < found && count < kMaxContactsPerBrick; ++i)
+  const float slack = 1e-3f * (1.f + std::min(halfA.maxCoeff(), halfB.maxCoeff()));
+  for (int i = 0; i < found && count < kMaxContactsPerBrick; ++i) {
+    // Two corners at one spot (a's corner on b's corner) count once.
+    if (std::any_of(out, out + count, [&](const LocalContact& c) { return (c.position - corners[i].point).norm() < slack; })) continue;
     out[count++] = {corners[i].point, n, -corners[i].gap, out[0].feature, out[0].material};
+  }
   return count;
 }
 
@@ -326,12 +360,20 @@ int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB,
   if (speculativeMargin <= 0.f) return col.count;
   int n = col.count;
   if (n == 0) {
-    // note: the detector reports touching boxes only; GJK measures the gap of separated ones
-    // (on the boxes' shapes with zero margins, so the gap is exact).
-    a.setMargin(0);
-    b.setMargin(0);
-    n = gjkEpa(a, trA, b, trB, feature, material, speculativeMargin, out);
-    if (n == 0) return 0;
+    // note: the detector reports touching boxes only. A separated pair's gap and nearest points
+    // come in closed form (collision/bricks/box_box_gap.h); GJK measures what that declines
+    // (touching to double rounding, or a near tie of two axes), on zero-margin shapes.
+    if (const std::optional<BoxGap> g =
+            separatedBoxGap(halfA, fromBt(trA.getBasis()), fromBt(trA.getOrigin()), halfB, fromBt(trB.getBasis()), fromBt(trB.getOrigin()))) {
+      if (g->gap >= speculativeMargin) return 0;
+      out[0] = {g->onB, g->normal, -g->gap, feature, material};
+      n = 1;
+    } else {
+      a.setMargin(0);
+      b.setMargin(0);
+      n = gjkEpa(a, trA, b, trB, feature, material, speculativeMargin, out);
+      if (n == 0) return 0;
+    }
   }
   return n < kMaxContactsPerBrick ? addSpeculativeCorners(halfA, trA, halfB, trB, speculativeMargin, out, n) : n;
 }
