@@ -12,6 +12,7 @@
 
 #include "collision/bricks/box_box_gap.h"
 #include "collision/bricks/brick_geometry.h"
+#include "collision/bricks/core_box_nearest.h"
 #include "collision/core/argument_checks.h"
 
 namespace bw {
@@ -172,6 +173,17 @@ int gjkEpa(const btConvexShape& shape, const btTransform& trShape, const btConve
 
 
 namespace {
+bool isCore(QueryShape::Kind k) { return k == QueryShape::Kind::Sphere || k == QueryShape::Kind::Capsule; }
+
+// The nearest points of a sphere's or capsule's core (its centre, or its segment along its local
+// z) and a box; nullopt when the core touches or enters the box.
+std::optional<CoreBoxNearest> coreNearestBox(const QueryShape& shape, const LocalPose& pose, const Vec3f& half,
+                                             const Mat3f& rotation, const Vec3f& centre) {
+  const Vec3f axis =
+      shape.kind == QueryShape::Kind::Capsule ? Vec3f(pose.rotation * Vec3f(0.f, 0.f, shape.halfHeight)) : Vec3f::Zero();
+  return coreBoxNearest(pose.position - axis, pose.position + axis, half, rotation, centre);
+}
+
 int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB, const btTransform& trB, uint32_t feature,
                  uint32_t material, float speculativeMargin, LocalContact* out);
 
@@ -210,6 +222,22 @@ int collideShapes(const QueryShape& a, const LocalPose& poseA, const QueryShape&
                   float speculativeMargin, LocalContact* out) {
   if (a.kind == QueryShape::Kind::Box && b.kind == QueryShape::Kind::Box)
     return collideBoxes(a.halfExtents, poseTransform(poseA), b.halfExtents, poseTransform(poseB), 0, 0, speculativeMargin, out);
+  // A sphere or capsule and a box, the core apart from the box: in closed form, either order.
+  const bool coreA = isCore(a.kind) && b.kind == QueryShape::Kind::Box, coreB = a.kind == QueryShape::Kind::Box && isCore(b.kind);
+  if (coreA || coreB) {
+    const QueryShape& core = coreA ? a : b;
+    const LocalPose& corePose = coreA ? poseA : poseB;
+    const LocalPose& boxPose = coreA ? poseB : poseA;
+    if (const std::optional<CoreBoxNearest> near = coreNearestBox(core, corePose, (coreA ? b : a).halfExtents,
+                                                                  boxPose.rotation.toRotationMatrix(), boxPose.position)) {
+      const float gap = near->distance - core.radius;
+      if (gap >= speculativeMargin) return 0;
+      // The point on b: the box's nearest point, or the core shape's surface nearest the box.
+      out[0] = coreA ? LocalContact{near->onBox, near->normal, -gap, 0, 0}
+                     : LocalContact{near->onCore - near->normal * core.radius, -near->normal, -gap, 0, 0};
+      return 1;
+    }
+  }
   return withBulletShape(a, [&](btConvexShape& sa) {
     return withBulletShape(b, [&](btConvexShape& sb) {
       return gjkEpa(sa, poseTransform(poseA), sb, poseTransform(poseB), 0, 0, speculativeMargin, out);
@@ -432,6 +460,40 @@ int addBoxCorners(const Vec3f& half, const btTransform& trBox, const Brick& bric
 }  // namespace
 
 namespace {
+// A sphere's or capsule's core apart from a box brick: its contact in closed form
+// (collision/bricks/core_box_nearest.h), and a capsule's ends as spheres of its radius, as
+// addCapsuleEnds does by GJK. -1 when the core touches or enters the brick: GJK/EPA measures
+// that penetration.
+int coreContacts(const QueryShape& shape, const LocalPose& pose, const Brick& b, uint32_t feature, float margin,
+                 LocalContact* out) {
+  const bool capsule = shape.kind == QueryShape::Kind::Capsule;
+  const Vec3f axis = capsule ? Vec3f(pose.rotation * Vec3f(0.f, 0.f, shape.halfHeight)) : Vec3f::Zero();
+  const Mat3f rotation = b.rotation.matrix();
+  auto contact = [&](const CoreBoxNearest& near, LocalContact& c) {
+    const float gap = near.distance - shape.radius;
+    if (gap >= margin) return false;
+    c = {near.onBox, near.normal, -gap, feature, b.material};
+    return true;
+  };
+  const std::optional<CoreBoxNearest> core = coreNearestBox(shape, pose, b.halfSize, rotation, b.position);
+  if (!core) return -1;
+  if (!contact(*core, out[0])) return 0;
+  int count = 1;
+  if (!capsule) return count;
+  const float slack = 1e-3f * (1.f + shape.radius + shape.halfHeight);
+  for (float sign : {-1.f, 1.f}) {
+    if (count >= kMaxContactsPerBrick) break;
+    const Vec3f end = pose.position + axis * sign;
+    const std::optional<CoreBoxNearest> near = coreBoxNearest(end, end, b.halfSize, rotation, b.position);
+    LocalContact c;
+    if (!near || !contact(*near, c)) continue;
+    if (std::any_of(out, out + count, [&](const LocalContact& o) { return (o.position - c.position).norm() < slack; })) continue;
+    c.shapePart = sign < 0.f ? 1 : 2;
+    out[count++] = c;
+  }
+  return count;
+}
+
 // A lower bound on the gap between the shape and the brick (0 when they may touch): the larger
 // of the distance between their grid-frame bounds and their separation along the shape's own
 // axes (the shape lies in its oriented box, the brick in its bounds). Cheap beside GJK, and
@@ -472,6 +534,11 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
     near.halfSize = part.halfExtent().cwiseMax(Vec3f::Constant(kMinBrickHalfSize));
     near.rotation = AxisRotation::identity();
     return collideShapeBrick(shape, pose, near, feature, speculativeMargin, out);
+  }
+  if (!huge && b.shape == BrickShape::Box &&
+      (shape.kind == QueryShape::Kind::Sphere || shape.kind == QueryShape::Kind::Capsule)) {
+    const int n = coreContacts(shape, pose, b, feature, speculativeMargin, out);
+    if (n >= 0) return n;
   }
   if (!huge && shape.kind == QueryShape::Kind::Box && b.shape == BrickShape::Box)
     return collideBoxes(shape.halfExtents, trShape, b.halfSize, trBrick, feature, b.material, speculativeMargin, out);
