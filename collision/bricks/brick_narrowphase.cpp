@@ -327,6 +327,7 @@ int addSpeculativeCorners(const Vec3f& halfA, const btTransform& trA, const Vec3
   };
   Corner corners[16];
   int found = 0;
+  const float slack = 1e-3f * (1.f + std::min(halfA.maxCoeff(), halfB.maxCoeff()));  // one spot
   // The corners of one box facing the other's face across the gap: only when the normal is a
   // face normal of the other (within 1 degree), as that face is then the plane the corners face,
   // through the other's nearest point; each corner's gap is measured along the normal to it, and
@@ -344,7 +345,6 @@ int addSpeculativeCorners(const Vec3f& halfA, const btTransform& trA, const Vec3
     }
     if (!(alignment > 0.99985f)) return;
     const Vec3f m = fromBt(basis.getColumn(axis)) * (toFace.dot(fromBt(basis.getColumn(axis))) > 0.f ? 1.f : -1.f);
-    const float slack = 1e-3f * (1.f + std::min(halfA.maxCoeff(), halfB.maxCoeff()));
     for (int i = 0; i < 8; ++i) {
       const Vec3f local((i & 1) ? half.x() : -half.x(), (i & 2) ? half.y() : -half.y(), (i & 4) ? half.z() : -half.z());
       const Vec3f v = fromBt(tr * bt(local));
@@ -361,7 +361,6 @@ int addSpeculativeCorners(const Vec3f& halfA, const btTransform& trA, const Vec3
   facing(halfA, trA, halfB, trB, onB, -n, false);  // a's corners onto b's face
   facing(halfB, trB, halfA, trA, onA, n, true);    // b's corners onto a's face
   sortSmall(corners, found, [](const Corner& x, const Corner& y) { return x.gap < y.gap; });  // nearest first
-  const float slack = 1e-3f * (1.f + std::min(halfA.maxCoeff(), halfB.maxCoeff()));
   for (int i = 0; i < found && count < kMaxContactsPerBrick; ++i) {
     // Two corners at one spot (a's corner on b's corner) count once.
     if (std::any_of(out, out + count, [&](const LocalContact& c) { return (c.position - corners[i].point).norm() < slack; })) continue;
@@ -535,8 +534,7 @@ int collideShapeBrick(const QueryShape& shape, const LocalPose& pose, const Bric
     near.rotation = AxisRotation::identity();
     return collideShapeBrick(shape, pose, near, feature, speculativeMargin, out);
   }
-  if (!huge && b.shape == BrickShape::Box &&
-      (shape.kind == QueryShape::Kind::Sphere || shape.kind == QueryShape::Kind::Capsule)) {
+  if (!huge && b.shape == BrickShape::Box && isCore(shape.kind)) {
     const int n = coreContacts(shape, pose, b, feature, speculativeMargin, out);
     if (n >= 0) return n;
   }
