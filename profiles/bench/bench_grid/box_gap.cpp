@@ -6,7 +6,8 @@
 // BoxGap_ClosedForm: separatedBoxGap (collision/bricks/box_box_gap.h), what collideBoxes runs
 //   now: time per pair, answered (the share it answers; the rest would go to GJK).
 // BoxGap_btGjkEpa: btGjkEpaSolver2::Distance on two zero-margin btBoxShapes, what collideBoxes
-//   ran before: time per pair, and its accuracy against the closed form (exact to float
+//   ran before (our before/after, not Bullet as its experts run it: btConvexConvexAlgorithm's
+//   btGjkPairDetector with a Voronoi simplex solver is not a row here): time per pair, and its accuracy against the closed form (exact to float
 //   rounding: tests/collision/bricks/box_box_gap_test.cpp checks it against brute force),
 //   gap_err_max (m) and normal_err_max.
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
