@@ -9,6 +9,7 @@
 ///   islands.build(solver.contacts(), bodies.motion);
 ///   solver.loadBodies(bodies, jobs, prof); solver.solve(islands, false, ...); solver.storeBodies(bodies, jobs, prof);
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "collision/bricks/contact.h"
@@ -40,6 +41,8 @@ class ContactSolver {
                const std::vector<uint8_t>& flipped, const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler,
                int stage);
   const std::vector<SolverContact>& contacts() const { return contacts_; }
+  /// The rest of each contact (warm-start key and point, shock and rolling data), same index.
+  const std::vector<SolverContactExtras>& contactExtras() const { return extras_; }
 
   /// Copies the bodies' velocities into the solver's compact records, and back (dynamic only).
   /// Copies the bodies' velocities in (and the solved ones back out), in parallel chunks with
@@ -55,21 +58,22 @@ class ContactSolver {
                    JobSystem& jobs, Profiler& profiler, int stage);
 
   /// Keeps the contacts' final impulses for the next substep's warm start (after the relax
-  /// pass), sorted by pair and feature in parallel: zones at stages `stage` (the copy) and
-  /// `stage` + 1 .. `stage` + 4 (the sort's four steps).
+  /// pass), sorted by pair and feature in parallel: zones at stages `stage` (the copy, with
+  /// each pair's contacts sorted when the pairs came in key order) and `stage` + 1 .. `stage` + 4
+  /// (the sort of the whole's four steps, when they did not).
   void keepImpulses(JobSystem& jobs, Profiler& profiler, int stage);
 
  private:
   /// Fewest pairs per job of prepare(): a contact costs ~100 ns, a pair up to manifoldSize of
   /// them, so 32 pairs are several microseconds.
   static constexpr uint32_t kMinPrepareGrain = 32;
-  SolverContact makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c,
-                            const SceneSettings& settings, float dt) const;
-  void applyImpulse(const SolverContact& s, int d, const Vec3f& dir, float lambda);
+  using CacheRange = std::pair<std::vector<CachedImpulse>::const_iterator, std::vector<CachedImpulse>::const_iterator>;
+  void makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c, CacheRange cached,
+                   const SceneSettings& settings, float dt, SolverContact& s, SolverContactExtras& x) const;
   void warmStart(const SolverContact& s);
-  void solveContact(SolverContact& s, bool relax);
-  void resistRolling(SolverContact& s);
-  void solveContactShock(SolverContact& s);
+  void solveContact(uint32_t k, bool relax);
+  void resistRolling(const SolverContact& s, SolverContactExtras& x);
+  void solveContactShock(uint32_t k);
   void shockSweep(std::vector<uint32_t>& contacts);
   void solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings);
   // `wave` numbers the island's waves (colours and serial steps, each a dependent step of
@@ -79,6 +83,15 @@ class ContactSolver {
   void solveIslandInColours(std::span<const uint32_t> island, IslandColouring& colouring, bool coloured,
                             const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
                             JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave);
+  // Contact i's impulses as the cache keeps them.
+  CachedImpulse cachedImpulse(uint32_t i) const;
+  // Whether prepare()'s pairs came in strictly increasing key order (empty pairs skipped).
+  bool pairsInKeyOrder() const;
+  // A cached impulse's pair against a pair key (the cache's first order).
+  struct PairOrder {
+    bool operator()(const CachedImpulse& x, uint64_t key) const { return x.pairKey < key; }
+    bool operator()(uint64_t key, const CachedImpulse& x) const { return key < x.pairKey; }
+  };
   // The cache's order: pair, feature, then the contact's index (what a stable sort by pair and
   // feature gives, as a strict total order the parallel sort needs).
   struct CacheOrder {
@@ -88,6 +101,7 @@ class ContactSolver {
   };
 
   std::vector<SolverContact> contacts_;
+  std::vector<SolverContactExtras> extras_;  // beside contacts_, same index
   std::vector<SolverBody> bodies_;
   std::vector<Mat3f> inverseInertiaWorld_;  // per body, this substep
   std::vector<uint32_t> first_;             // prepare(): pair k's contacts start at first_[k]

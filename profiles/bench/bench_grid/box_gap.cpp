@@ -6,11 +6,23 @@
 // BoxGap_ClosedForm: separatedBoxGap (collision/bricks/box_box_gap.h), what collideBoxes runs
 //   now: time per pair, answered (the share it answers; the rest would go to GJK).
 // BoxGap_btGjkEpa: btGjkEpaSolver2::Distance on two zero-margin btBoxShapes, what collideBoxes
-//   ran before (our before/after, not Bullet as its experts run it: btConvexConvexAlgorithm's
-//   btGjkPairDetector with a Voronoi simplex solver is not a row here): time per pair, and its accuracy against the closed form (exact to float
-//   rounding: tests/collision/bricks/box_box_gap_test.cpp checks it against brute force),
-//   gap_err_max (m) and normal_err_max.
+//   ran before (our before/after, not Bullet as its experts run it): time per pair, and its
+//   accuracy against the closed form (exact to float rounding:
+//   tests/collision/bricks/box_box_gap_test.cpp checks it against brute force), gap_err_max (m)
+//   and normal_err_max.
+// BoxGap_btGjkPairDetector/margin_mm:M: the path Bullet's own world runs for a convex pair that
+//   wants closest points (btConvexConvexAlgorithm: btGjkPairDetector with a
+//   btVoronoiSimplexSolver and a btGjkEpaPenetrationDepthSolver, made once and reused), on
+//   btBoxShapes with margin 0 and with Bullet's default 0.04 m (the core shrunk by the margin,
+//   then swept by a sphere of it: rounded edges and corners, so its gap differs from the box's
+//   where the nearest feature is an edge or a corner). Same counters as the row above. Note: a
+//   Bullet world's box-box pairs go to btBoxBoxCollisionAlgorithm instead, which reports no
+//   contact for separated boxes at all: no speculative contact to compare.
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
+#include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
+#include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 #include <benchmark/benchmark.h>
 #include <btBulletCollisionCommon.h>
 #include <cmath>
@@ -114,8 +126,53 @@ void BoxGap_btGjkEpa(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()));
 }
 
+// One pair through btGjkPairDetector as btConvexConvexAlgorithm runs it (no distance cap: every
+// pair here is within a speculative margin). Gap and normal (from b towards a) when it answers.
+struct DetectorAnswer {
+  bool answered;
+  double gap;
+  Vec3f normal;
+};
+DetectorAnswer gjkPairDetector(const BoxPair& p, float margin, btVoronoiSimplexSolver& simplex, btGjkEpaPenetrationDepthSolver& epa) {
+  btBoxShape a(btVector3(p.halfA.x(), p.halfA.y(), p.halfA.z())), b(btVector3(p.halfB.x(), p.halfB.y(), p.halfB.z()));
+  a.setMargin(margin);
+  b.setMargin(margin);
+  btGjkPairDetector detector(&a, &b, &simplex, &epa);
+  btGjkPairDetector::ClosestPointInput input;
+  input.m_transformA = transformOf(p.rotationA, p.centreA);
+  input.m_transformB = transformOf(p.rotationB, p.centreB);
+  btPointCollector out;
+  detector.getClosestPoints(input, out, nullptr);
+  const btVector3& n = out.m_normalOnBInWorld;
+  return {out.m_hasResult, double(out.m_distance), Vec3f(n.x(), n.y(), n.z())};
+}
+
+void BoxGap_btGjkPairDetector(benchmark::State& state) {
+  const std::vector<BoxPair>& all = pairs();
+  const float margin = float(state.range(0)) * 1e-3f;
+  btVoronoiSimplexSolver simplex;
+  btGjkEpaPenetrationDepthSolver epa;
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(gjkPairDetector(all[i++ & (all.size() - 1)], margin, simplex, epa));
+  // Accuracy, untimed, against the closed form on every pair both answer.
+  double gapErr = 0, normalErr = 0, answered = 0;
+  for (const BoxPair& p : all) {
+    const std::optional<BoxGap> g = separatedBoxGap(p.halfA, p.rotationA, p.centreA, p.halfB, p.rotationB, p.centreB);
+    const DetectorAnswer d = gjkPairDetector(p, margin, simplex, epa);
+    answered += d.answered;
+    if (!g || !d.answered) continue;
+    gapErr = std::max(gapErr, std::abs(d.gap - double(g->gap)));
+    normalErr = std::max(normalErr, double((d.normal.normalized() - g->normal).norm()));
+  }
+  state.counters["answered"] = answered / double(all.size());
+  state.counters["gap_err_max"] = gapErr;
+  state.counters["normal_err_max"] = normalErr;
+  state.SetItemsProcessed(int64_t(state.iterations()));
+}
+
 BENCHMARK(BoxGap_ClosedForm);
 BENCHMARK(BoxGap_btGjkEpa);
+BENCHMARK(BoxGap_btGjkPairDetector)->ArgName("margin_mm")->Arg(0)->Arg(40);
 
 }  // namespace
 }  // namespace bw
