@@ -23,6 +23,20 @@ BodyStore groundAndTwoBoxes() {
   return bodies;
 }
 
+// The rest of a substep after prepare(), default settings: islands, the solve, the relax pass,
+// the velocities stored and the impulses kept for the next substep's warm start.
+void solvePrepared(ContactSolver& solver, BodyStore& bodies, JobSystem& jobs, Profiler& profiler) {
+  const SceneSettings settings;
+  Islands islands;
+  islands.build(solver.contacts(), bodies.motion, jobs, profiler, 0);
+  islands.groupContacts(solver.contacts(), bodies.motion, jobs, profiler, 0);
+  solver.loadBodies(bodies, jobs, profiler);
+  solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
+  solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);
+  solver.storeBodies(bodies, jobs, profiler);
+  solver.keepImpulses(jobs, profiler, 0);
+}
+
 // One solve of the given pairs, each with one contact under its box, ending with the relax
 // pass that stores the impulses for the next substep's warm start.
 void solveOnce(ContactSolver& solver, BodyStore& bodies, const std::vector<BodyPair>& pairs,
@@ -35,14 +49,7 @@ void solveOnce(ContactSolver& solver, BodyStore& bodies, const std::vector<BodyP
   }
   const std::vector<uint8_t> flipped(pairs.size(), 1);  // normal from the ground (a) to the box (b)
   solver.prepare(bodies, pairs, contacts, flipped, settings, 1.f / 60, jobs, profiler, 0);
-  Islands islands;
-  islands.build(solver.contacts(), bodies.motion, jobs, profiler, 0);
-  islands.groupContacts(solver.contacts(), bodies.motion, jobs, profiler, 0);
-  solver.loadBodies(bodies, jobs, profiler);
-  solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
-  solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);
-  solver.storeBodies(bodies, jobs, profiler);
-  solver.keepImpulses(jobs, profiler, 0);
+  solvePrepared(solver, bodies, jobs, profiler);
 }
 
 TEST(ContactSolver, WarmStartMatchesPairAndFeatureAtFullWidth) {
@@ -130,13 +137,7 @@ TEST(ContactSolver, WarmStartPicksWhatABruteForceScanPicks) {
       const std::vector<uint8_t> flipped(pairs.size(), 1);
       ContactSolver solver;
       solver.prepare(bodies, pairs, manifolds(), flipped, settings, 1.f / 60, jobs, profiler, 0);
-      Islands islands;
-      islands.build(solver.contacts(), bodies.motion, jobs, profiler, 0);
-      islands.groupContacts(solver.contacts(), bodies.motion, jobs, profiler, 0);
-      solver.loadBodies(bodies, jobs, profiler);
-      solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
-      solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);
-      solver.keepImpulses(jobs, profiler, 0);
+      solvePrepared(solver, bodies, jobs, profiler);
       const std::vector<SolverContact> last = solver.contacts();
       const std::vector<SolverContactExtras> lastExtras = solver.contactExtras();
       ASSERT_GT(last.size(), 300u);

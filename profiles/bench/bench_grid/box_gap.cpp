@@ -12,8 +12,9 @@
 //   and normal_err_max.
 // BoxGap_btGjkPairDetector/margin_mm:M: the path Bullet's own world runs for a convex pair that
 //   wants closest points (btConvexConvexAlgorithm: btGjkPairDetector with a
-//   btVoronoiSimplexSolver and a btGjkEpaPenetrationDepthSolver, made once and reused), on
-//   btBoxShapes with margin 0 and with Bullet's default 0.04 m (the core shrunk by the margin,
+//   btVoronoiSimplexSolver and a btGjkEpaPenetrationDepthSolver made once and reused, the
+//   detector made per pair as the algorithm makes it per call, the shapes built beforehand as a
+//   world holds them), on btBoxShapes with margin 0 and with Bullet's default 0.04 m (the core shrunk by the margin,
 //   then swept by a sphere of it: rounded edges and corners, so its gap differs from the box's
 //   where the nearest feature is an edge or a corner). Same counters as the row above. Note: a
 //   Bullet world's box-box pairs go to btBoxBoxCollisionAlgorithm instead, which reports no
@@ -26,6 +27,7 @@
 #include <benchmark/benchmark.h>
 #include <btBulletCollisionCommon.h>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -133,11 +135,24 @@ struct DetectorAnswer {
   double gap;
   Vec3f normal;
 };
-DetectorAnswer gjkPairDetector(const BoxPair& p, float margin, btVoronoiSimplexSolver& simplex, btGjkEpaPenetrationDepthSolver& epa) {
-  btBoxShape a(btVector3(p.halfA.x(), p.halfA.y(), p.halfA.z())), b(btVector3(p.halfB.x(), p.halfB.y(), p.halfB.z()));
-  a.setMargin(margin);
-  b.setMargin(margin);
-  btGjkPairDetector detector(&a, &b, &simplex, &epa);
+// A pair's two boxes as Bullet shapes with the given margin, built once per run.
+struct BulletBoxes {
+  std::unique_ptr<btBoxShape> a, b;
+};
+std::vector<BulletBoxes> bulletBoxes(const std::vector<BoxPair>& all, float margin) {
+  std::vector<BulletBoxes> out;
+  for (const BoxPair& p : all) {
+    out.push_back({std::make_unique<btBoxShape>(btVector3(p.halfA.x(), p.halfA.y(), p.halfA.z())),
+                   std::make_unique<btBoxShape>(btVector3(p.halfB.x(), p.halfB.y(), p.halfB.z()))});
+    out.back().a->setMargin(margin);
+    out.back().b->setMargin(margin);
+  }
+  return out;
+}
+
+DetectorAnswer gjkPairDetector(const BoxPair& p, const BulletBoxes& shapes, btVoronoiSimplexSolver& simplex,
+                               btGjkEpaPenetrationDepthSolver& epa) {
+  btGjkPairDetector detector(shapes.a.get(), shapes.b.get(), &simplex, &epa);
   btGjkPairDetector::ClosestPointInput input;
   input.m_transformA = transformOf(p.rotationA, p.centreA);
   input.m_transformB = transformOf(p.rotationB, p.centreB);
@@ -149,16 +164,20 @@ DetectorAnswer gjkPairDetector(const BoxPair& p, float margin, btVoronoiSimplexS
 
 void BoxGap_btGjkPairDetector(benchmark::State& state) {
   const std::vector<BoxPair>& all = pairs();
-  const float margin = float(state.range(0)) * 1e-3f;
+  const std::vector<BulletBoxes> shapes = bulletBoxes(all, float(state.range(0)) * 1e-3f);
   btVoronoiSimplexSolver simplex;
   btGjkEpaPenetrationDepthSolver epa;
   size_t i = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(gjkPairDetector(all[i++ & (all.size() - 1)], margin, simplex, epa));
+  for (auto _ : state) {
+    const size_t k = i++ & (all.size() - 1);
+    benchmark::DoNotOptimize(gjkPairDetector(all[k], shapes[k], simplex, epa));
+  }
   // Accuracy, untimed, against the closed form on every pair both answer.
   double gapErr = 0, normalErr = 0, answered = 0;
-  for (const BoxPair& p : all) {
+  for (size_t k = 0; k < all.size(); ++k) {
+    const BoxPair& p = all[k];
     const std::optional<BoxGap> g = separatedBoxGap(p.halfA, p.rotationA, p.centreA, p.halfB, p.rotationB, p.centreB);
-    const DetectorAnswer d = gjkPairDetector(p, margin, simplex, epa);
+    const DetectorAnswer d = gjkPairDetector(p, shapes[k], simplex, epa);
     answered += d.answered;
     if (!g || !d.answered) continue;
     gapErr = std::max(gapErr, std::abs(d.gap - double(g->gap)));
