@@ -75,14 +75,20 @@ class EditLoad {
     float wallY = 0.f;
     bool wallStarted = false;
   };
-  uint64_t next(Stream& s);
-  uint32_t below(Stream& s, uint32_t n);
+  /// The stream's random draws (splitmix64 on its state): a copy of the state draws ahead.
+  static uint64_t next(uint64_t& rng);
+  static uint32_t below(uint64_t& rng, uint32_t n);
   void remove(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
   void place(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
   void carve(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
   void wall(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
   bool isFree(uint32_t gridIndex, const BrickGrid& grid, const Brick& b);
+  /// Asks for what the next kPlaceLookAhead source draws of a place stream will read (their
+  /// bricks, then the index paths of the spots on top of them) without drawing; returns how
+  /// many draws it covered.
+  uint32_t lookAheadPlacements(const Stream& s, const BrickGrid& grid, const LiveBricks& live);
   static constexpr uint32_t kPlaceSources = 4;  // source bricks a placement tries before it is skipped
+  static constexpr uint32_t kPlaceLookAhead = 16;  // source draws whose reads are asked for at once
   // The grid edits themselves, timed into stats.gridEditMs.
   uint32_t timedPlace(uint32_t gridIndex, BrickGrid& grid, const Brick& b, EditLoadStats& st);
   void timedRemove(uint32_t gridIndex, BrickGrid& grid, uint32_t id, EditLoadStats& st);
@@ -94,6 +100,7 @@ class EditLoad {
   std::vector<uint32_t> scratch_;  // overlap results
   std::vector<uint32_t> picks_;    // a remove stream's bricks for this frame
   std::vector<Brick> pending_;     // a place stream's group of chosen spots, not placed yet
+  std::vector<Brick> aheadSpots_;  // lookAheadPlacements' spots
   const Blocked* blocked_ = nullptr;  // during apply()
   const Hooks* hooks_ = nullptr;      // during apply()
   std::vector<std::pair<uint32_t, Aabb>> touched_;
