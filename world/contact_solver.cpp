@@ -206,8 +206,8 @@ struct ContactBodies {
 
 }  // namespace
 
-void ContactSolver::warmStart(const SolverContact& s) {
-  ContactBodies ab{bodies_[s.a], bodies_[s.b]};
+void ContactSolver::warmStart(const SolverContact& s, SolverBody& a, SolverBody& b) {
+  ContactBodies ab{a, b};
   ab.apply(s, 0, s.normal, s.lambdaN);
   ab.apply(s, 1, s.t1, s.lambdaT1);
   ab.apply(s, 2, s.t2, s.lambdaT2);
@@ -216,9 +216,9 @@ void ContactSolver::warmStart(const SolverContact& s) {
 
 // One Gauss-Seidel update of one contact: normal impulse clamped at zero, then friction
 // clamped by the Coulomb bound.
-void ContactSolver::solveContact(uint32_t k, bool relax) {
+void ContactSolver::solveContact(uint32_t k, bool relax, SolverBody& a, SolverBody& b) {
   SolverContact& s = contacts_[k];
-  ContactBodies ab{bodies_[s.a], bodies_[s.b]};
+  ContactBodies ab{a, b};
   const float oldN = s.lambdaN;
   const float lambdaN = std::max(oldN + s.massN * ((relax ? s.relaxBias : s.bias) - ab.relative(s).dot(s.normal)), 0.f);
   ab.apply(s, 0, s.normal, lambdaN - oldN);
@@ -233,16 +233,14 @@ void ContactSolver::solveContact(uint32_t k, bool relax) {
   s.lambdaN = lambdaN;
   s.lambdaT1 = lambdaT1;
   s.lambdaT2 = lambdaT2;
-  if (s.rolling > 0.f) resistRolling(s, extras_[k]);
+  if (s.rolling > 0.f) resistRolling(s, extras_[k], a, b);
 }
 
 // Rolling resistance: the relative spin about the two tangent axes (rolling, not spinning about
 // the normal) is opposed by an angular impulse within a cone of rolling x lambdaN, as friction
 // opposes sliding. Without it a capsule that lands spinning about its axis rolls forever and
 // never sleeps.
-void ContactSolver::resistRolling(const SolverContact& s, SolverContactExtras& x) {
-  SolverBody& a = bodies_[s.a];
-  SolverBody& b = bodies_[s.b];
+void ContactSolver::resistRolling(const SolverContact& s, SolverContactExtras& x, SolverBody& a, SolverBody& b) {
   const Vec3f w = a.w - b.w;
   const float o1 = x.lambdaR1, o2 = x.lambdaR2;
   clampToFrictionCone(o1 - x.massR[0] * w.dot(s.t1), o2 - x.massR[1] * w.dot(s.t2), s.rolling * s.lambdaN, x.lambdaR1, x.lambdaR2);
@@ -337,7 +335,7 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
   const char* const name = relax ? "relax: colour" : "colour";
   if (!coloured) {
     ProfileZone zone(profiler, relax ? "relax: colouring" : "colouring", waveStage(stage, wave), true);
-    colouring.colour(island, contacts_, motion);
+    colouring.colour(island, contacts_, motion, extras_, jobs);
   }
   const uint32_t colours = colouring.colours();
   // Every pass over the colours in order, as waves of one parallel region: each colour's
@@ -365,20 +363,30 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
   if (!relax) pass(true, false);
   const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
   for (int it = 0; it < iterations; ++it) pass(false, it & 1);
+  // The island's bodies into their slots, and back once the waves are done.
+  const std::vector<uint32_t>& slotBodies = colouring.slotBodies();
+  slots_.resize(slotBodies.size());
+  for (size_t i = 0; i < slotBodies.size(); ++i)
+    if (slotBodies[i] != kInvalidIndex) slots_[i] = bodies_[slotBodies[i]];
   jobs.parallelWaves(chunks, [&](uint32_t w, uint32_t chunk) {
     const Wave& v = waves[w];
     const std::span<const uint32_t> group = colouring.colour(v.colour);
+    const std::span<const IslandColouring::SlotPair> slots = colouring.slotPairs(v.colour);
     const bool serial = v.colour == kMaxColours;  // the serial group: contacts may share bodies
     const uint32_t begin = serial ? 0 : chunk * kColourGrain;
     const uint32_t end = serial ? uint32_t(group.size()) : std::min(uint32_t(group.size()), begin + kColourGrain);
     ProfileZone zone(profiler, v.warmStart ? "warm start" : name, v.stageId, serial);
     for (uint32_t j = begin; j < end; ++j) {
+      SolverBody& a = slots_[slots[j].a];
+      SolverBody& b = slots_[slots[j].b];
       if (v.warmStart)
-        warmStart(contacts_[group[j]]);
+        warmStart(contacts_[group[j]], a, b);
       else
-        solveContact(group[j], relax);
+        solveContact(group[j], relax, a, b);
     }
   });
+  for (size_t i = 0; i < slotBodies.size(); ++i)
+    if (slotBodies[i] != kInvalidIndex && slots_[i].dynamic) bodies_[slotBodies[i]] = slots_[i];
   if (!relax && settings.shockPropagation) {  // one serial sweep over the whole pile
     ProfileZone zone(profiler, "shock sweep", waveStage(stage, wave), true);
     std::vector<uint32_t> list(colouring.all().begin(), colouring.all().end());

@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include <oneapi/tbb/cache_aligned_allocator.h>
+
 #include "collision/bricks/contact.h"
 #include "jobs/job_system.h"
 #include "jobs/parallel_sort.h"
@@ -70,9 +72,12 @@ class ContactSolver {
   using CacheRange = std::pair<std::vector<CachedImpulse>::const_iterator, std::vector<CachedImpulse>::const_iterator>;
   void makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c, CacheRange cached,
                    const SceneSettings& settings, float dt, SolverContact& s, SolverContactExtras& x) const;
-  void warmStart(const SolverContact& s);
-  void solveContact(uint32_t k, bool relax);
-  void resistRolling(const SolverContact& s, SolverContactExtras& x);
+  // On the bodies' records (bodies_), or on the given records (a coloured island's slots).
+  void warmStart(const SolverContact& s) { warmStart(s, bodies_[s.a], bodies_[s.b]); }
+  void warmStart(const SolverContact& s, SolverBody& a, SolverBody& b);
+  void solveContact(uint32_t k, bool relax) { solveContact(k, relax, bodies_[contacts_[k].a], bodies_[contacts_[k].b]); }
+  void solveContact(uint32_t k, bool relax, SolverBody& a, SolverBody& b);
+  void resistRolling(const SolverContact& s, SolverContactExtras& x, SolverBody& a, SolverBody& b);
   void solveContactShock(uint32_t k);
   void shockSweep(std::vector<uint32_t>& contacts);
   void solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings);
@@ -103,6 +108,9 @@ class ContactSolver {
   std::vector<SolverContact> contacts_;
   std::vector<SolverContactExtras> extras_;  // beside contacts_, same index
   std::vector<SolverBody> bodies_;
+  // A coloured island's bodies in its colouring's slots while its waves run (on line pairs of
+  // their own: IslandColouring::kSlotsApart).
+  std::vector<SolverBody, tbb::cache_aligned_allocator<SolverBody>> slots_;
   std::vector<Mat3f> inverseInertiaWorld_;  // per body, this substep
   std::vector<uint32_t> first_;             // prepare(): pair k's contacts start at first_[k]
   std::vector<CachedImpulse> cache_, nextCache_;

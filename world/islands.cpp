@@ -85,21 +85,100 @@ void Islands::groupContacts(const std::vector<SolverContact>& contacts, const st
   start_.push_back(m);
 }
 
-void IslandColouring::colour(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
-                             const std::vector<MotionType>& motion) {
-  bodyColours_.resize(motion.size(), 0);
+namespace {
+
+// Bits 0-3 of x, y, z interleaved, z lowest: a 16^3 cell's Morton number. Its top bit halves
+// the island across x, not z: a pile is wider than tall, and a vertical cut meets fewer bodies.
+uint32_t mortonCell(uint32_t x, uint32_t y, uint32_t z) {
+  uint32_t m = 0;
+  for (int b = 0; b < 4; ++b) m |= ((z >> b) & 1u) << (3 * b) | ((y >> b) & 1u) << (3 * b + 1) | ((x >> b) & 1u) << (3 * b + 2);
+  return m;
+}
+
+}  // namespace
+
+void IslandColouring::cellsOf(std::span<const uint32_t> island, const std::vector<SolverContactExtras>& points) {
   const uint32_t n = uint32_t(island.size());
+  if (n == 0) {
+    byCell_.clear();
+    return;
+  }
+  // One pass over the contacts' records: each point relative to the first (small, so float
+  // keeps it to well under a cell far from the origin too) and their bounds.
+  const Vec3d origin = points[island[0]].point;
+  relative_.resize(n);
+  Vec3f lo = Vec3f::Zero(), hi = Vec3f::Zero();
+  for (uint32_t j = 0; j < n; ++j) {
+    const Vec3f p = (points[island[j]].point - origin).cast<float>();
+    relative_[j] = p;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  constexpr int kCells = 16;
+  float scale[3];
+  for (int a = 0; a < 3; ++a) scale[a] = hi[a] > lo[a] ? float(kCells) / (hi[a] - lo[a]) : 0.f;
+  cellOf_.resize(n);
+  for (uint32_t j = 0; j < n; ++j) {
+    uint32_t q[3];
+    for (int a = 0; a < 3; ++a) q[a] = uint32_t(std::clamp(int((relative_[j][a] - lo[a]) * scale[a]), 0, kCells - 1));
+    cellOf_[j] = uint16_t(mortonCell(q[0], q[1], q[2]));
+  }
+  // Island positions by cell, island order within a cell.
+  cellStart_.assign(kCells * kCells * kCells + 1, 0);
+  for (uint32_t j = 0; j < n; ++j) ++cellStart_[cellOf_[j] + 1];
+  for (size_t c = 1; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
+  byCell_.resize(n);
+  for (uint32_t j = 0; j < n; ++j) byCell_[cellStart_[cellOf_[j]]++] = j;
+}
+
+void IslandColouring::colour(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
+                             const std::vector<MotionType>& motion, const std::vector<SolverContactExtras>& points,
+                             JobSystem& jobs) {
+  // The colours and the cells do not depend on each other: side by side on two threads.
+  jobs.parallelFor(0, 2, 1, [&](uint32_t task, uint32_t) {
+    if (task == 0)
+      colourGroups(island, contacts, motion);
+    else
+      cellsOf(island, points);
+  });
+  assignSlots();
+  const uint32_t n = uint32_t(island.size());
+  solveOrder_.resize(n);
+  slotPairs_.resize(n);
+  fill_.assign(start_.begin(), start_.end() - 1);
+  const auto place = [&](uint32_t j) {
+    const uint32_t p = fill_[colourOf_[j]]++;
+    solveOrder_[p] = island[j];
+    slotPairs_[p] = {slotOf_[ends_[j].a], slotOf_[ends_[j].b]};
+  };
+  for (uint32_t j : byCell_)
+    if (colourOf_[j] != tuning::kMaxColours) place(j);
+  for (uint32_t j = 0; j < n; ++j)
+    if (colourOf_[j] == tuning::kMaxColours) place(j);
+  for (const Ends& e : ends_) bodyColours_[e.a] = bodyColours_[e.b] = 0;  // clean for the next island
+  for (uint32_t x : slotBody_)
+    if (x != kInvalidIndex) slotOf_[x] = kInvalidIndex;
+}
+
+void IslandColouring::colourGroups(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
+                                   const std::vector<MotionType>& motion) {
+  const uint32_t n = uint32_t(island.size());
+  ends_.resize(n);
+  for (uint32_t j = 0; j < n; ++j) {
+    const SolverContact& s = contacts[island[j]];
+    ends_[j] = {s.a, s.b, motion[s.a] == MotionType::Dynamic, motion[s.b] == MotionType::Dynamic};
+  }
+  bodyColours_.resize(motion.size(), 0);
   colourOf_.resize(n);
   uint32_t used = 0;
   for (uint32_t j = 0; j < n; ++j) {
-    const SolverContact& s = contacts[island[j]];
-    uint64_t taken = 0;
-    for (uint32_t x : {s.a, s.b})
-      if (motion[x] == MotionType::Dynamic) taken |= bodyColours_[x];
+    const Ends& e = ends_[j];
+    const uint64_t taken = (e.dynamicA ? bodyColours_[e.a] : 0) | (e.dynamicB ? bodyColours_[e.b] : 0);
     const uint32_t colour = taken == ~uint64_t(0) ? tuning::kMaxColours : uint32_t(std::countr_one(taken));
-    if (colour < tuning::kMaxColours)
-      for (uint32_t x : {s.a, s.b})
-        if (motion[x] == MotionType::Dynamic) bodyColours_[x] |= uint64_t(1) << colour;
+    if (colour < tuning::kMaxColours) {
+      if (e.dynamicA) bodyColours_[e.a] |= uint64_t(1) << colour;
+      if (e.dynamicB) bodyColours_[e.b] |= uint64_t(1) << colour;
+    }
     colourOf_[j] = colour;
     used = std::max(used, colour + 1);
   }
@@ -110,10 +189,28 @@ void IslandColouring::colour(std::span<const uint32_t> island, const std::vector
   contacts_.resize(n);
   fill_.assign(start_.begin(), start_.end() - 1);
   for (uint32_t j = 0; j < n; ++j) contacts_[fill_[colourOf_[j]]++] = island[j];
-  for (uint32_t j = 0; j < n; ++j) {
-    const SolverContact& s = contacts[island[j]];
-    bodyColours_[s.a] = bodyColours_[s.b] = 0;  // clean for the next island
+}
+
+void IslandColouring::assignSlots() {
+  // Static and kinematic bodies first, then dynamic ones, each in the order the cells meet them.
+  slotOf_.resize(bodyColours_.size(), kInvalidIndex);
+  fixed_.clear();
+  moving_.clear();
+  for (uint32_t j : byCell_) {
+    const Ends& e = ends_[j];
+    for (int k = 0; k < 2; ++k) {
+      const uint32_t x = k ? e.b : e.a;
+      if (slotOf_[x] != kInvalidIndex) continue;
+      std::vector<uint32_t>& list = (k ? e.dynamicB : e.dynamicA) ? moving_ : fixed_;
+      slotOf_[x] = uint32_t(list.size());
+      list.push_back(x);
+    }
   }
+  const uint32_t firstMoving = (uint32_t(fixed_.size()) + kSlotsApart - 1) / kSlotsApart * kSlotsApart;
+  slotBody_.assign(firstMoving + moving_.size(), kInvalidIndex);
+  std::copy(fixed_.begin(), fixed_.end(), slotBody_.begin());
+  std::copy(moving_.begin(), moving_.end(), slotBody_.begin() + firstMoving);
+  for (uint32_t x : moving_) slotOf_[x] += firstMoving;
 }
 
 }  // namespace bw
