@@ -90,8 +90,7 @@ class ContactSolver {
                             JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave);
   // Contact i's impulses as the cache keeps them.
   CachedImpulse cachedImpulse(uint32_t i) const;
-  // Whether prepare()'s pairs came in strictly increasing key order (empty pairs skipped).
-  bool pairsInKeyOrder() const;
+
   // A cached impulse's pair against a pair key (the cache's first order).
   struct PairOrder {
     bool operator()(const CachedImpulse& x, uint64_t key) const { return x.pairKey < key; }
@@ -113,6 +112,7 @@ class ContactSolver {
   std::vector<SolverBody, tbb::cache_aligned_allocator<SolverBody>> slots_;
   std::vector<Mat3f> inverseInertiaWorld_;  // per body, this substep
   std::vector<uint32_t> first_;             // prepare(): pair k's contacts start at first_[k]
+  bool pairsInKeyOrder_ = false;            // prepare(): its pairs with contacts in strictly increasing key order
   std::vector<CachedImpulse> cache_, nextCache_;
   std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
   // The colourings of this substep's split islands, in solve order; valid for the relax pass

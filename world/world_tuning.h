@@ -121,6 +121,9 @@ inline constexpr uint32_t kMaxColours = 64;
 /// did (1.72-1.75x, session 18), and 16 a little under (1.66-1.76x) with its chunks of ~0.6 us
 /// near what a wave's hand-over costs.
 inline constexpr uint32_t kColourGrain = 32;
+/// Fewest contacts in a colour's chunk when a small colour is cut for many threads (a chunk's
+/// two atomic adds cost about what a few contacts do).
+inline constexpr uint32_t kMinColourChunk = 8;
 /// Fewest pairs per job of the step's counters (a few loads and adds per pair).
 inline constexpr uint32_t kMinCounterGrain = 256;
 /// Pairs per job in contact generation (a pair may be a grid query of many bricks).
