@@ -347,8 +347,9 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
                                          JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave) {
   const char* const name = relax ? "relax: colour" : "colour";
   if (!coloured) {
-    ProfileZone zone(profiler, relax ? "relax: colouring" : "colouring", waveStage(stage, wave), true);
-    colouring.colour(island, contacts_, motion, extras_, jobs);
+    const int32_t jobsStage = waveStage(stage, wave);
+    colouring.colour(island, contacts_, motion, extras_, jobs, profiler, relax ? "relax: colouring" : "colouring", jobsStage,
+                     waveStage(stage, wave));
   }
   const uint32_t colours = colouring.colours();
   // Every pass over the colours in order, as waves of one parallel region: each colour's

@@ -133,14 +133,18 @@ void IslandColouring::cellsOf(std::span<const uint32_t> island, const std::vecto
 
 void IslandColouring::colour(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
                              const std::vector<MotionType>& motion, const std::vector<SolverContactExtras>& points,
-                             JobSystem& jobs) {
+                             JobSystem& jobs, Profiler& profiler, const char* name, int32_t stage, int32_t slotsStage) {
   // The colours and the cells do not depend on each other: side by side on two threads.
   jobs.parallelFor(0, 2, 1, [&](uint32_t task, uint32_t) {
-    if (task == 0)
+    if (task == 0) {
+      ProfileZone zone(profiler, name, stage);
       colourGroups(island, contacts, motion);
-    else
+    } else {
+      ProfileZone zone(profiler, "colouring: cells", stage);
       cellsOf(island, points);
+    }
   });
+  ProfileZone zone(profiler, "colouring: slots", slotsStage, true);
   assignSlots();
   const uint32_t n = uint32_t(island.size());
   solveOrder_.resize(n);

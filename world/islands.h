@@ -60,8 +60,12 @@ class IslandColouring {
   /// slice of every colour then lies in one part of the pile, and the bodies there stay in its
   /// cache from colour to colour instead of moving between cores at every wave. Contacts of a
   /// colour share no dynamic body, so their order inside it does not change the result.
+  /// The colours and the cells are two jobs on `jobs` (zones `name` and "colouring: cells" at
+  /// `stage`), the slots and the order within colours one serial step after them (zone
+  /// "colouring: slots" at `slotsStage`).
   void colour(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
-              const std::vector<MotionType>& motion, const std::vector<SolverContactExtras>& points, JobSystem& jobs);
+              const std::vector<MotionType>& motion, const std::vector<SolverContactExtras>& points, JobSystem& jobs,
+              Profiler& profiler, const char* name, int32_t stage, int32_t slotsStage);
 
   uint32_t colours() const { return uint32_t(start_.size() - 1); }
   /// Contacts (indices into the contact list) of colour c, in cell order (the serial group,

@@ -165,9 +165,10 @@ TEST(IslandColouring, GroupsCellOrderAndSlotsMatchASerialReference) {
     for (int threads : {1, 4}) {
       SCOPED_TRACE(std::to_string(threads) + " threads");
       JobSystem jobs(threads);
+      Profiler profiler;
       IslandColouring fresh;
       for (IslandColouring* colouring : {&fresh, &reused}) {
-        colouring->colour(island, contacts, motion, extras, jobs);
+        colouring->colour(island, contacts, motion, extras, jobs, profiler, "colouring", 0, 1);
         ASSERT_EQ(colouring->colours(), groups.size());
         // Slots: every island body once, fixed bodies first, the moving ones from a multiple of
         // kSlotsApart, padding only between them.
