@@ -81,8 +81,8 @@ class IslandColouring {
   /// ones in the order the cells first meet them. A thread's slice of a colour then writes
   /// bodies that lie together in memory as well as in space: bodies numbered by the scene
   /// sit scattered, and a thread writing one pulled its neighbours, written by the other
-  /// thread, along (crate_pile on two threads: the colour waves' work was 1.65x one thread's,
-  /// 1.34x in slots; profiles/RESULTS.md, session 32).
+  /// thread, along (crate_pile on two threads: the colour waves' work was 1.65-1.93x one
+  /// thread's, 1.26-1.38x in slots; profiles/RESULTS.md, session 32).
   struct SlotPair {
     uint32_t a, b;
   };
