@@ -347,9 +347,10 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
                                          JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave) {
   const char* const name = relax ? "relax: colour" : "colour";
   if (!coloured) {
-    const int32_t jobsStage = waveStage(stage, wave);
-    colouring.colour(island, contacts_, motion, extras_, jobs, profiler, relax ? "relax: colouring" : "colouring", jobsStage,
-                     waveStage(stage, wave));
+    const int32_t colourStage = waveStage(stage, wave);  // in this order: each call takes the next id
+    const int32_t slotsStage = waveStage(stage, wave);
+    colouring.colour(island, contacts_, motion, extras_, jobs, profiler, relax ? "relax: colouring" : "colouring", colourStage,
+                     slotsStage);
   }
   const uint32_t colours = colouring.colours();
   // Every pass over the colours in order, as waves of one parallel region: each colour's
