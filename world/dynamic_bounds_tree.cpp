@@ -6,6 +6,7 @@
 #include <string>
 
 #include "collision/core/errors.h"
+#include "collision/core/morton.h"
 #include "jobs/chunked_for.h"
 
 namespace bw {
@@ -207,17 +208,6 @@ uint32_t DynamicBoundsTree::rotateUp(uint32_t a, uint32_t up) {
 
 // ------------------------------------------------------------------------------- bulk build
 
-// Spreads the low 21 bits of v so that two zero bits follow each (bit i moves to bit 3i).
-uint64_t DynamicBoundsTree::spread(uint64_t v) {
-  v &= 0x1fffff;
-  v = (v | v << 32) & 0x1f00000000ffffull;
-  v = (v | v << 16) & 0x1f0000ff0000ffull;
-  v = (v | v << 8) & 0x100f00f00f00f00full;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-  v = (v | v << 2) & 0x1249249249249249ull;
-  return v;
-}
-
 void DynamicBoundsTree::split(const Range& r, Range& left, Range& right) {
   // Where the range's first and last codes first differ (the octree cell boundary between its
   // halves); a range of equal codes splits in the middle.
@@ -294,7 +284,7 @@ void DynamicBoundsTree::build(const std::vector<WorldAabb>& boxes, const std::ve
   forChunks(n, itemGrain, stage + 1, "dynamic tree: codes", [&](uint32_t begin, uint32_t end) {
     for (uint32_t k = begin; k < end; ++k) {
       const Vec3d q = ((boxes[k].min + boxes[k].max - lo).cwiseProduct(scale)).cwiseMax(0.0).cwiseMin(cells);
-      codes_[k] = {spread(uint64_t(q.x())) << 2 | spread(uint64_t(q.y())) << 1 | spread(uint64_t(q.z())), k};
+      codes_[k] = {mortonCode(uint64_t(q.x()), uint64_t(q.y()), uint64_t(q.z())), k};
     }
   });
   if (jobs) {

@@ -164,7 +164,6 @@ class DynamicBoundsTree {
 
   // Bulk build: the leaf node of build position p, a range's split into two, a whole subtree.
   uint32_t buildLeaf(uint32_t p) const { return buildCount_ - 1 + p; }
-  static uint64_t spread(uint64_t v);
   void split(const Range& r, Range& left, Range& right);
   void buildSubtree(const Range& r);
 

@@ -148,7 +148,10 @@ void EditLoad::place(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats
     bool done = false;
     // A few source bricks, each tried on top first, then beside it, where nothing is yet.
     for (uint32_t source = 0; source < kPlaceSources && !done && !live.ids.empty(); ++source) {
-      if (drawn == askedFor) askedFor = drawn + lookAheadPlacements(s, grid, live);
+      if (drawn == askedFor) {
+        lookAheadPlacements(s, grid, live);
+        askedFor = drawn + kPlaceLookAhead;
+      }
       ++drawn;
       const Brick from = grid.brick(live.ids[below(s.rng, uint32_t(live.ids.size()))]);
       const Vec3f size = brickBounds(from).extent();
@@ -170,8 +173,8 @@ void EditLoad::place(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats
   placePending(s.grid, grid, live, st);
 }
 
-uint32_t EditLoad::lookAheadPlacements(const Stream& s, const BrickGrid& grid, const LiveBricks& live) {
-  if (live.ids.empty()) return kPlaceLookAhead;
+void EditLoad::lookAheadPlacements(const Stream& s, const BrickGrid& grid, const LiveBricks& live) {
+  if (live.ids.empty()) return;
   uint64_t rng = s.rng;  // the stream's next draws, not drawn
   uint32_t ids[kPlaceLookAhead];
   for (uint32_t i = 0; i < kPlaceLookAhead; ++i) {
@@ -185,7 +188,6 @@ uint32_t EditLoad::lookAheadPlacements(const Stream& s, const BrickGrid& grid, c
     aheadSpots_.push_back(top);
   }
   grid.prefetchPlacements(aheadSpots_);
-  return kPlaceLookAhead;
 }
 
 void EditLoad::placePending(uint32_t gridIndex, BrickGrid& grid, LiveBricks& live, EditLoadStats& st) {

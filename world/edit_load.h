@@ -84,9 +84,8 @@ class EditLoad {
   void wall(Stream& s, BrickGrid& grid, LiveBricks& live, EditLoadStats& st);
   bool isFree(uint32_t gridIndex, const BrickGrid& grid, const Brick& b);
   /// Asks for what the next kPlaceLookAhead source draws of a place stream will read (their
-  /// bricks, then the index paths of the spots on top of them) without drawing; returns how
-  /// many draws it covered.
-  uint32_t lookAheadPlacements(const Stream& s, const BrickGrid& grid, const LiveBricks& live);
+  /// bricks, then the index paths of the spots on top of them) without drawing.
+  void lookAheadPlacements(const Stream& s, const BrickGrid& grid, const LiveBricks& live);
   static constexpr uint32_t kPlaceSources = 4;  // source bricks a placement tries before it is skipped
   static constexpr uint32_t kPlaceLookAhead = 16;  // source draws whose reads are asked for at once
   // The grid edits themselves, timed into stats.gridEditMs.

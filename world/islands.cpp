@@ -5,6 +5,7 @@
 #include <bit>
 
 #include "collision/core/ids.h"
+#include "collision/core/morton.h"
 #include "world/world_tuning.h"
 
 namespace bw {
@@ -85,18 +86,6 @@ void Islands::groupContacts(const std::vector<SolverContact>& contacts, const st
   start_.push_back(m);
 }
 
-namespace {
-
-// Bits 0-3 of x, y, z interleaved, z lowest: a 16^3 cell's Morton number. Its top bit halves
-// the island across x, not z: a pile is wider than tall, and a vertical cut meets fewer bodies.
-uint32_t mortonCell(uint32_t x, uint32_t y, uint32_t z) {
-  uint32_t m = 0;
-  for (int b = 0; b < 4; ++b) m |= ((z >> b) & 1u) << (3 * b) | ((y >> b) & 1u) << (3 * b + 1) | ((x >> b) & 1u) << (3 * b + 2);
-  return m;
-}
-
-}  // namespace
-
 void IslandColouring::cellsOf(std::span<const uint32_t> island, const std::vector<SolverContactExtras>& points) {
   const uint32_t n = uint32_t(island.size());
   if (n == 0) {
@@ -121,7 +110,9 @@ void IslandColouring::cellsOf(std::span<const uint32_t> island, const std::vecto
   for (uint32_t j = 0; j < n; ++j) {
     uint32_t q[3];
     for (int a = 0; a < 3; ++a) q[a] = uint32_t(std::clamp(int((relative_[j][a] - lo[a]) * scale[a]), 0, kCells - 1));
-    cellOf_[j] = uint16_t(mortonCell(q[0], q[1], q[2]));
+    // note: x highest, so the code's top bit halves the island across x, not z: a pile is
+    // wider than tall, and a vertical cut between two threads' slices meets fewer bodies.
+    cellOf_[j] = uint16_t(mortonCode(q[0], q[1], q[2]));
   }
   // Island positions by cell, island order within a cell.
   cellStart_.assign(kCells * kCells * kCells + 1, 0);
@@ -145,7 +136,7 @@ void IslandColouring::colour(std::span<const uint32_t> island, const std::vector
     }
   });
   ProfileZone zone(profiler, "colouring: slots", slotsStage, true);
-  assignSlots();
+  assignSlots(uint32_t(motion.size()));
   const uint32_t n = uint32_t(island.size());
   solveOrder_.resize(n);
   slotPairs_.resize(n);
@@ -159,7 +150,6 @@ void IslandColouring::colour(std::span<const uint32_t> island, const std::vector
     if (colourOf_[j] != tuning::kMaxColours) place(j);
   for (uint32_t j = 0; j < n; ++j)
     if (colourOf_[j] == tuning::kMaxColours) place(j);
-  for (const Ends& e : ends_) bodyColours_[e.a] = bodyColours_[e.b] = 0;  // clean for the next island
   for (uint32_t x : slotBody_)
     if (x != kInvalidIndex) slotOf_[x] = kInvalidIndex;
 }
@@ -193,11 +183,12 @@ void IslandColouring::colourGroups(std::span<const uint32_t> island, const std::
   contacts_.resize(n);
   fill_.assign(start_.begin(), start_.end() - 1);
   for (uint32_t j = 0; j < n; ++j) contacts_[fill_[colourOf_[j]]++] = island[j];
+  for (const Ends& e : ends_) bodyColours_[e.a] = bodyColours_[e.b] = 0;  // clean for the next island
 }
 
-void IslandColouring::assignSlots() {
+void IslandColouring::assignSlots(uint32_t bodies) {
   // Static and kinematic bodies first, then dynamic ones, each in the order the cells meet them.
-  slotOf_.resize(bodyColours_.size(), kInvalidIndex);
+  slotOf_.resize(bodies, kInvalidIndex);
   fixed_.clear();
   moving_.clear();
   for (uint32_t j : byCell_) {

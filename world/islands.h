@@ -107,8 +107,9 @@ class IslandColouring {
   std::vector<Vec3f> relative_;        // per island position: its point, from the first one's
   std::vector<uint16_t> cellOf_;       // per island position: its cell
   std::vector<uint32_t> cellStart_, byCell_;  // island positions in cell order (counting sort)
-  /// Gives the island's bodies their slots (slotOf_, slotBody_) from ends_ in cell order.
-  void assignSlots();
+  /// Gives the island's bodies (ids below `bodies`) their slots (slotOf_, slotBody_) from ends_
+  /// in cell order.
+  void assignSlots(uint32_t bodies);
   struct Ends {  // an island contact's bodies, read once
     uint32_t a, b;
     bool dynamicA, dynamicB;
