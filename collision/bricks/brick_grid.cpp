@@ -394,10 +394,20 @@ size_t BrickGrid::collide(const RigidTransform& gridPose, const QueryShape& shap
   gridPose.validate("BrickGrid::collide (grid pose)");
   shapePose.validate("BrickGrid::collide (shape pose)");
   shape.validate("BrickGrid::collide");
+  validateContactParams(params, "BrickGrid::collide");
+  return collideChecked(gridPose, shape, shapePose, params, scratch, out, stats);
+}
+
+void BrickGrid::validateContactParams(const ContactParams& params, const char* context) {
   if (params.maxContacts < 1 || params.maxContacts > 64)
-    throw InvalidInput("BrickGrid::collide: params.maxContacts is " + std::to_string(params.maxContacts) + ", expected 1..64");
-  requireInRange(params.lodFraction, 0.0, 1.0, "BrickGrid::collide", "params.lodFraction");
-  requireFinite(params.speculativeMargin, "BrickGrid::collide", "params.speculativeMargin");
+    throw InvalidInput(std::string(context) + ": params.maxContacts is " + std::to_string(params.maxContacts) + ", expected 1..64");
+  requireInRange(params.lodFraction, 0.0, 1.0, context, "params.lodFraction");
+  requireFinite(params.speculativeMargin, context, "params.speculativeMargin");
+}
+
+size_t BrickGrid::collideChecked(const RigidTransform& gridPose, const QueryShape& shape, const RigidTransform& shapePose,
+                                 const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out,
+                                 ContactStats* stats) const {
   const LocalPose pose{gridPose.pointToLocal(shapePose.translation), gridPose.rotationToLocal(shapePose.rotation).normalized()};
   scratch.raw.clear();
   collideLocal(shape, pose, params, scratch.raw, stats);

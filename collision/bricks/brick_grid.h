@@ -199,6 +199,13 @@ class BrickGrid {
   size_t collide(const RigidTransform& gridPose, const QueryShape& shape, const RigidTransform& shapePose,
                  const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out,
                  ContactStats* stats = nullptr) const;
+  /// collide without checking its arguments, for a caller that checked them already (collideGrids
+  /// checks the two poses and params once a pair, then collides every brick of a small grid).
+  size_t collideChecked(const RigidTransform& gridPose, const QueryShape& shape, const RigidTransform& shapePose,
+                        const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out,
+                        ContactStats* stats = nullptr) const;
+  /// InvalidInput naming `context` and the field, for params collide cannot take.
+  static void validateContactParams(const ContactParams& params, const char* context);
   /// The same in the grid frame, without reduction (raw per-brick contacts appended).
   void collideLocal(const QueryShape& shape, const LocalPose& pose, const ContactParams& params,
                     std::vector<LocalContact>& out, ContactStats* stats = nullptr) const;

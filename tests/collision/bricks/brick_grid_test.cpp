@@ -429,6 +429,24 @@ TEST(BrickGrid, BadBricksAndQueriesAreRejectedWithoutChanges) {
   bad.translation.x() = std::nan("");
   EXPECT_THROW(grid.collide(RigidTransform{}, QueryShape::sphere(1), bad, ContactParams{}, scratch, out), InvalidInput);
   EXPECT_THROW(grid.collide(RigidTransform{}, QueryShape::sphere(-1), RigidTransform{}, ContactParams{}, scratch, out), InvalidInput);
+  // Grid against grid: checked once a pair (the bricks then collide unchecked), on every path:
+  // brick by brick (a one-brick grid) and through the hull (a bigger one).
+  BrickGrid small, large;
+  small.placeBrick(Brick::box(Vec3f(0, 0, 0.9f), Vec3f::Constant(0.5f)));
+  for (int i = 0; i < int(kBrickwiseGridBricks) + 1; ++i) large.placeBrick(Brick::box(Vec3f(float(i), 0, 0), Vec3f::Constant(0.5f)));
+  ContactParams tooMany;
+  tooMany.maxContacts = 65;
+  RigidTransform tilted;
+  tilted.rotation.coeffs() << 0.5f, 0.f, 0.f, 0.5f;  // not a unit quaternion
+  int smaller = -1;
+  for (BrickGrid* other : {&small, &large}) {
+    EXPECT_THROW(collideGrids(grid, RigidTransform{}, *other, bad, 2, ContactParams{}, scratch, out, smaller), InvalidInput);
+    EXPECT_THROW(collideGrids(grid, tilted, *other, RigidTransform{}, 2, ContactParams{}, scratch, out, smaller), InvalidInput);
+    EXPECT_THROW(collideGrids(grid, RigidTransform{}, *other, RigidTransform{}, 2, tooMany, scratch, out, smaller), InvalidInput);
+    EXPECT_TRUE(out.empty()) << "nothing is reported for refused input";
+    EXPECT_GT(collideGrids(grid, RigidTransform{}, *other, RigidTransform{}, 2, ContactParams{}, scratch, out, smaller), 0u);
+    out.clear();
+  }
   try {
     grid.placeBrick(Brick::box(Vec3f(0, 0, 0), Vec3f(0.5f, nan, 0.5f)));
   } catch (const InvalidInput& e) {

@@ -33,6 +33,7 @@ TEST(AxisRotation, TwentyFourDistinctExactRotations) {
       EXPECT_EQ(r.applyToExtent(v.cwiseAbs()), r.apply(v).cwiseAbs());
     }
     EXPECT_TRUE(r.quaternion().toRotationMatrix().isApprox(m, 1e-6f));
+    EXPECT_EQ(r.quaternion().coeffs(), Quatf(m).normalized().coeffs()) << "the table holds what the matrix gives";
     // Local +Z ("up") points along the direction.
     Vec3f dir = Vec3f::Zero();
     dir[r.direction() / 2] = (r.direction() % 2 == 0) ? 1.f : -1.f;

@@ -290,6 +290,74 @@ TEST(TerrainContacts, WaterGivesSubmergedVolumeForBuoyancy) {
   EXPECT_FALSE(terrainWaterContact(terrain, sphereAt(Vec3d(10, 13, 10), 0.5f), w));
 }
 
+// The water sums voxel by voxel, as a reference reading every voxel through VoxelTerrain::get
+// (terrainWaterContact reads a chunk layer at a time and skips chunks without water): the same
+// bits, on terrains whose size is no multiple of a chunk, with water of any fill, solid and air
+// mixed in, and boxes across chunk borders and past the terrain's edges.
+TEST(TerrainContacts, WaterSumsEqualAVoxelByVoxelReference) {
+  std::mt19937 rng(20261128);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  int compared = 0, wet = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const Int3 size{9 + int(rng() % 22), 5 + int(rng() % 14), 9 + int(rng() % 22)};
+    const float vs = trial % 3 == 0 ? 0.5f : 1.f;
+    Terrain terrain(size, vs);
+    // Water up to a level, some of it partly filled, solid lumps and air pockets through it.
+    const int level = 1 + int(rng() % uint32_t(size.y - 1));
+    terrain.fillBox({0, 0, 0}, {size.x - 1, level - 1, size.z - 1}, Voxel::make(kMaterialWater));
+    for (int k = 0; k < 200; ++k) {
+      const Int3 v{int(rng() % uint32_t(size.x)), int(rng() % uint32_t(size.y)), int(rng() % uint32_t(size.z))};
+      const uint32_t kind = rng() % 4;
+      const Voxel voxel = kind == 0 ? Voxel::make(kMaterialWater, uint8_t(1 + rng() % 255))
+                        : kind == 1 ? Voxel::make(kMaterialFirstSolid)
+                        : kind == 2 ? Voxel::make(kMaterialWater) : Voxel{};
+      terrain.fillBox(v, v, voxel);
+    }
+    for (int q = 0; q < 40; ++q) {
+      // Axis-aligned boxes (terrain placed at the origin): the shape's local box is exactly
+      // centre -+ half, which the reference recomputes.
+      const Vec3f half(0.2f + 6.f * unit(rng), 0.2f + 4.f * unit(rng), 0.2f + 6.f * unit(rng));
+      const Vec3f centre(-3.f + (float(size.x) * vs + 6.f) * unit(rng), -2.f + (float(size.y) * vs + 4.f) * unit(rng),
+                         -3.f + (float(size.z) * vs + 6.f) * unit(rng));
+      const Placed box = boxAt(centre.cast<double>(), Quatf::Identity(), half);
+      WaterContact got;
+      const bool hit = terrainWaterContact(terrain, box, got);
+      const Aabb b = Aabb::fromCenterHalf(centre, half);
+      int lo[3], hi[3];
+      const int n[3] = {size.x, size.y, size.z};
+      for (int i = 0; i < 3; ++i) {
+        lo[i] = int(std::clamp(std::floor(double(b.min[i]) / vs), 0.0, double(n[i] - 1)));
+        hi[i] = int(std::clamp(std::floor(double(b.max[i]) / vs), 0.0, double(n[i] - 1)));
+      }
+      double volume = 0;
+      Vec3d moment = Vec3d::Zero();
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int z = lo[2]; z <= hi[2]; ++z)
+          for (int x = lo[0]; x <= hi[0]; ++x) {
+            const Voxel v = terrain.voxels().get({x, y, z});
+            if (!v.isWater()) continue;
+            const Vec3f cellMin(float(x) * vs, float(y) * vs, float(z) * vs);
+            const Vec3f cellMax(cellMin.x() + vs, cellMin.y() + vs * float(v.occupancy) / 255.f, cellMin.z() + vs);
+            const Vec3f omin = cellMin.cwiseMax(b.min), omax = cellMax.cwiseMin(b.max);
+            if ((omin.array() >= omax.array()).any()) continue;
+            const double ov = double((omax - omin).prod());
+            volume += ov;
+            moment += ov * ((omin + omax) * 0.5f).cast<double>();
+          }
+      ++compared;
+      // (the terrain's own water test can end the query before the voxels: only when none overlap)
+      ASSERT_EQ(hit, volume > 0) << "trial " << trial << " query " << q;
+      if (!hit) continue;
+      ++wet;
+      EXPECT_EQ(got.submergedVolume, volume * (double(box.shape.volume()) / double(b.volume()))) << "trial " << trial << " query " << q;
+      // (the terrain sits at the origin: the centre is the local one, in float)
+      EXPECT_EQ(got.centreOfBuoyancy.cast<float>(), Vec3f((moment / volume).cast<float>())) << "trial " << trial << " query " << q;
+    }
+  }
+  EXPECT_EQ(compared, 12 * 40);
+  EXPECT_GT(wet, 12 * 10);  // most boxes meet water: the comparison is not of empty sums
+}
+
 TEST(TerrainContacts, RejectsInvalidShapes) {
   const auto holder = flatTerrain();
   Terrain& terrain = *holder;
