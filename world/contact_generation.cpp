@@ -129,18 +129,18 @@ void World::generateContacts(float dt) {
       params.speculativeMargin = tuning::kSpeculativeMargin + closingSpeed(a, b) * dt;
       const BodyShape& sa = bodies_.shape[a];
       const BodyShape& sb = bodies_.shape[b];
+      // note: a body's shape was checked when it was added and its pose is the integrator's
+      // (rotation normalised, position checked finite by the broadphase's bounds every step):
+      // checking them again for every pair was 3% of ship_refit's step. The params carry this
+      // step's margin, so they are still checked.
+      BrickGrid::validateContactParams(params, "World (contacts)");
       if (sa.isGrid() && sb.isGrid()) {
         int smaller = 0;
-        collideGrids(*grids_[sa.grid], bodies_.shapePose(a), *grids_[sb.grid], bodies_.shapePose(b),
-                     scene_.settings.approximationDepth, params, scratch_[k], out, smaller, &pairStats_[k], scene_.settings.gridPairs);
+        collideGridsChecked(*grids_[sa.grid], bodies_.shapePose(a), *grids_[sb.grid], bodies_.shapePose(b),
+                            scene_.settings.approximationDepth, params, scratch_[k], out, smaller, &pairStats_[k], scene_.settings.gridPairs);
         pairFlipped_[k] = smaller == 1;  // normals point from the larger (a) to the smaller (b)
       } else if (sa.isGrid() || sb.isGrid()) {
         const uint32_t g = sa.isGrid() ? a : b, p = sa.isGrid() ? b : a;
-        // note: a body's shape was checked when it was added and its pose is the integrator's
-        // (rotation normalised, position checked finite by the broadphase's bounds every step):
-        // checking both again for every pair was 3% of ship_refit's step. The params carry this
-        // step's margin, so they are still checked.
-        BrickGrid::validateContactParams(params, "World (contacts)");
         grids_[bodies_.shape[g].grid]->collideChecked(bodies_.shapePose(g), bodies_.shape[p].primitive, bodies_.shapePose(p), params,
                                                       scratch_[k], out, &pairStats_[k]);
         pairFlipped_[k] = p == b;  // normals point from the grid towards the primitive

@@ -75,11 +75,13 @@ float World::deepestStaticOverlap(uint32_t body, const Vec3d& position, ContactS
     if (bodies_.shape[g].isGrid() && isGrid) {
       // Grid against grid as a step pairs them (the scene's grid_pairs): two interlocked chain
       // links overlap as hulls but not as bricks.
+      // note: unchecked: the bodies' poses and shapes were checked when added, and each spot the
+      // start search tries is one of them moved by a finite offset (the search tries thousands).
       int smaller = 0;
-      collideGrids(*grids_[bodies_.shape[g].grid], bodies_.shapePose(g), *grids_[bodies_.shape[body].grid], gridPose,
-                   scene_.settings.approximationDepth, params, scratch, contacts, smaller, nullptr, scene_.settings.gridPairs);
+      collideGridsChecked(*grids_[bodies_.shape[g].grid], bodies_.shapePose(g), *grids_[bodies_.shape[body].grid], gridPose,
+                          scene_.settings.approximationDepth, params, scratch, contacts, smaller, nullptr, scene_.settings.gridPairs);
     } else if (bodies_.shape[g].isGrid()) {
-      grids_[bodies_.shape[g].grid]->collide(bodies_.shapePose(g), shape, pose, params, scratch, contacts);
+      grids_[bodies_.shape[g].grid]->collideChecked(bodies_.shapePose(g), shape, pose, params, scratch, contacts);
     } else if (bodies_.shape[g].isTerrain()) {
       terrainContacts(*terrains_[bodies_.shape[g].terrain], shape, pose, 0.f, contacts);
     }

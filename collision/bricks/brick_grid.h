@@ -81,6 +81,7 @@ struct ConvexApproximation {
   Aabb bounds = Aabb::empty();
   std::vector<Vec3f> vertices;    ///< hull vertices (the 8 corners when isBox)
   std::vector<Vec3f> centered;    ///< the same relative to shapeCenter(), for shape()
+  Vec3f centeredHalfExtents = Vec3f::Zero();  ///< their bounds (found once: shape() is made for every query)
   double hullVolume = 0;
   double brickVolume = 0;         ///< the bricks' own volume (the hull's fill: hullVolume / this)
   int depth = 0;
@@ -274,5 +275,10 @@ inline uint32_t smallFeature(uint32_t feature, uint32_t brick) { return feature 
 size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
                     const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
                     ContactStats* stats = nullptr, GridPairMode mode = GridPairMode::Convex);
+/// collideGrids without checking the poses and params, for a caller that holds them valid (the
+/// world: its bodies' poses are the integrator's; its start search tries thousands of them).
+size_t collideGridsChecked(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
+                           const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
+                           ContactStats* stats = nullptr, GridPairMode mode = GridPairMode::Convex);
 
 }  // namespace bw

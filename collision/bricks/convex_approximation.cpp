@@ -77,7 +77,7 @@ void BrickGrid::coverBoxes(uint32_t maxBoxes, std::vector<Aabb>& out) const {
 
 QueryShape ConvexApproximation::shape() const {
   if (isBox) return QueryShape::box(bounds.halfExtent().cwiseMax(Vec3f::Constant(1e-4f)));
-  return QueryShape::hull(centered.data(), uint32_t(centered.size()), float(hullVolume));
+  return QueryShape::hull(centered.data(), uint32_t(centered.size()), float(hullVolume), centeredHalfExtents);
 }
 
 Vec3f ConvexApproximation::shapeCenter() const { return bounds.center(); }
@@ -128,6 +128,7 @@ ConvexApproximation BrickGrid::buildConvexApproximation(int depth) const {
   }
   const Vec3f c = a.bounds.center();
   for (const Vec3f& v : a.vertices) a.centered.push_back(v - c);
+  a.centeredHalfExtents = QueryShape::hull(a.centered.data(), uint32_t(a.centered.size())).hullHalfExtents;
   return a;
 }
 
@@ -145,14 +146,20 @@ const ConvexApproximation& BrickGrid::convexApproximation(int depth) {
 size_t collideGrids(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
                     const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
                     ContactStats* stats, GridPairMode mode) {
-  // By brick count; when both are small enough to go brick by brick, the one of smaller extent
-  // (its bricks against the other's, not a 120 m yard brick against a rubble part's: box vs
-  // brick of such sizes gave 27 m deep contacts, demolition).
-  // note: checked once here, not once a brick by collide in the brick-by-brick loop below (a
-  // 8% of demolition's instructions went to checking the same poses again).
+  // note: checked once here, not once a brick by collide in the brick-by-brick loop (checking the
+  // same poses again was 8% of demolition's instructions).
   poseA.validate("collideGrids (pose a)");
   poseB.validate("collideGrids (pose b)");
   BrickGrid::validateContactParams(params, "collideGrids");
+  return collideGridsChecked(a, poseA, b, poseB, depth, params, scratch, out, smallerIndex, stats, mode);
+}
+
+size_t collideGridsChecked(BrickGrid& a, const RigidTransform& poseA, BrickGrid& b, const RigidTransform& poseB, int depth,
+                           const ContactParams& params, ContactScratch& scratch, std::vector<Contact>& out, int& smallerIndex,
+                           ContactStats* stats, GridPairMode mode) {
+  // By brick count; when both are small enough to go brick by brick, the one of smaller extent
+  // (its bricks against the other's, not a 120 m yard brick against a rubble part's: box vs
+  // brick of such sizes gave 27 m deep contacts, demolition).
   const bool bothSmall = a.brickCount() <= kBrickwiseGridBricks && b.brickCount() <= kBrickwiseGridBricks;
   const bool aSmaller = bothSmall ? a.bounds().halfExtent().squaredNorm() <= b.bounds().halfExtent().squaredNorm()
                                   : a.brickCount() <= b.brickCount();

@@ -14,11 +14,7 @@ Vec3f QueryShape::localHalfExtents() const {
     case Kind::Sphere: return Vec3f::Constant(radius);
     case Kind::Box: return halfExtents;
     case Kind::Capsule: return Vec3f(radius, radius, radius + halfHeight);
-    case Kind::Hull: {
-      Vec3f e = Vec3f::Zero();
-      for (uint32_t i = 0; i < pointCount; ++i) e = e.cwiseMax(points[i].cwiseAbs());
-      return e;
-    }
+    case Kind::Hull: return hullHalfExtents;
   }
   return Vec3f::Zero();
 }
