@@ -367,6 +367,18 @@ TEST(BrickGrid, ConvexApproximationDetectsBoxesButNeverWedges) {
   }
   EXPECT_FALSE(ell.convexApproximation(3).isBox);
   EXPECT_NEAR(ell.convexApproximation(3).hullVolume, 3.5, 1e-3);
+  // The hull's query shape carries its points' bounds, found once: the largest |coordinate| of
+  // its points per axis, as a walk over them finds (the L's hull is not centred on its points).
+  for (const ConvexApproximation* a : {&aw, &ell.convexApproximation(3)}) {
+    const QueryShape shape = a->shape();
+    ASSERT_EQ(shape.kind, QueryShape::Kind::Hull);
+    Vec3f walked = Vec3f::Zero();
+    for (uint32_t i = 0; i < shape.pointCount; ++i) walked = walked.cwiseMax(shape.points[i].cwiseAbs());
+    EXPECT_EQ(shape.localHalfExtents(), walked);
+    EXPECT_GT(walked.minCoeff(), 0.f);
+  }
+  const Vec3f skewed[4] = {{-3, 0, 0}, {1, 0.5f, 0}, {0, -2, 0.25f}, {0, 0, 7}};
+  EXPECT_EQ(QueryShape::hull(skewed, 4).localHalfExtents(), Vec3f(3, 2, 7));
   // Cached until an edit.
   const uint32_t extra = ell.placeBrick(Brick::box(Vec3f(1, 1, 0), Vec3f::Constant(0.5f)));
   EXPECT_TRUE(ell.convexApproximation(3).isBox);
