@@ -132,8 +132,8 @@ void World::generateContacts(float dt) {
       // note: a body's shape was checked when it was added and its pose is the integrator's
       // (rotation normalised, position checked finite by the broadphase's bounds every step):
       // checking them again for every pair was 3% of ship_refit's step. The params carry this
-      // step's margin, so they are still checked.
-      BrickGrid::validateContactParams(params, "World (contacts)");
+      // step's margin, so a grid pair still checks them (as collide did).
+      if (sa.isGrid() || sb.isGrid()) BrickGrid::validateContactParams(params, "World (contacts)");
       if (sa.isGrid() && sb.isGrid()) {
         int smaller = 0;
         collideGridsChecked(*grids_[sa.grid], bodies_.shapePose(a), *grids_[sb.grid], bodies_.shapePose(b),
