@@ -116,7 +116,6 @@ void World::resolveStartsInSolid() {
   // way too: twenty crates spawned in one tower must not all be let go in the same spot.
   std::vector<uint32_t> placed;
   std::vector<Vec3d> placedAt;
-  std::vector<float> placedReach;  // (a hull's reach walks its points: once a body, not once a candidate spot)
   for (uint32_t body = 0, next = 0; body < bodies_.size(); ++body) {
     if (next < inSolid.size() && inSolid[next] == body) {
       ++next;
@@ -125,7 +124,6 @@ void World::resolveStartsInSolid() {
     if (bodies_.motion[body] == MotionType::Dynamic && !bodies_.shape[body].isGrid()) {
       placed.push_back(body);
       placedAt.push_back(bodies_.position[body]);
-      placedReach.push_back(bodies_.shape[body].primitive.localHalfExtents().norm());
     }
   }
   auto overlapsPlaced = [&](uint32_t body, const Vec3d& p) {
@@ -135,7 +133,7 @@ void World::resolveStartsInSolid() {
     for (size_t k = 0; k < placed.size(); ++k) {
       const QueryShape& other = bodies_.shape[placed[k]].primitive;
       const Vec3d offset = placedAt[k] - p;
-      if (offset.norm() > double(reach + placedReach[k])) continue;
+      if (offset.norm() > double(reach + other.localHalfExtents().norm())) continue;
       LocalContact c[kMaxContactsPerBrick];
       const int n = collideShapes(shape, LocalPose{Vec3f::Zero(), bodies_.rotation[body]}, other,
                                   LocalPose{offset.cast<float>(), bodies_.rotation[placed[k]]}, 0.f, c);
@@ -196,7 +194,6 @@ void World::resolveStartsInSolid() {
     if (!bodies_.shape[body].isGrid()) {
       placed.push_back(body);
       placedAt.push_back(start + d.remaining);
-      placedReach.push_back(bodies_.shape[body].primitive.localHalfExtents().norm());
     }
     // Kinematic and a ghost on the way out: it passes through the solid it leaves and through
     // other bodies. (Pushing them aside, it crushed one against a wall; the impulse kept for
