@@ -75,9 +75,10 @@ std::vector<uint32_t> BrickGrid::placeValidBricks(const std::vector<Brick>& bric
   return ids;
 }
 
-void BrickGrid::fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds) {
+void BrickGrid::fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
+                                bool boundsFromIndex) {
   try {
-    indexValidBricks(ids, bricks, bounds);
+    indexValidBricks(ids, bricks, bounds, boundsFromIndex);
   } catch (...) {
     for (uint32_t id : ids) bricks_.free(id);
     throw;
@@ -85,11 +86,14 @@ void BrickGrid::fillValidBricks(const std::vector<uint32_t>& ids, const std::vec
   addValidBricks(ids, bricks);
 }
 
-void BrickGrid::indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds) {
+void BrickGrid::indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
+                                 bool boundsFromIndex) {
   std::vector<uint32_t> filters;
   filters.reserve(bricks.size());
   for (const Brick& b : bricks) filters.push_back(b.filter);
-  const std::vector<uint32_t> elements = index_.bulkLoad(bounds, filters, ids);  // validates every box before building
+  // (bulkLoad validates every box before building: the range of a brick's bounds is checked there)
+  const std::vector<uint32_t> elements =
+      boundsFromIndex ? index_.bulkLoadValid(bounds, filters, ids) : index_.bulkLoad(bounds, filters, ids);
   for (size_t i = 0; i < ids.size(); ++i) bricks_.get<1>(ids[i]) = elements[i];
 }
 
@@ -152,19 +156,20 @@ BrickGrid::Move BrickGrid::prepareMove(std::span<const uint32_t> ids, BrickGrid&
     m.bounds_.push_back(index_.bounds(e));  // the brick's bounds as indexed (brickBounds of it)
     m.elements_.push_back(e);
   }
-  m.newIds_.reserve(ids.size());
-  for (size_t i = 0; i < ids.size(); ++i) m.newIds_.push_back(into.bricks_.allocate());
+  m.newIds_.resize(ids.size());
+  into.bricks_.allocateMany(uint32_t(ids.size()), m.newIds_.data());
+  m.fromEdits_ = edits_;
   return m;
 }
 
 void BrickGrid::receiveMove(Move& m) {
   BW_ASSERT(m.into_ == this);
-  fillValidBricks(m.newIds_, m.bricks_, m.bounds_);
+  fillValidBricks(m.newIds_, m.bricks_, m.bounds_, true);
 }
 
 void BrickGrid::receiveMoveIndex(Move& m) {
   BW_ASSERT(m.into_ == this);
-  indexValidBricks(m.newIds_, m.bricks_, m.bounds_);
+  indexValidBricks(m.newIds_, m.bricks_, m.bounds_, true);
 }
 
 void BrickGrid::receiveMoveBricks(Move& m) {
@@ -186,7 +191,11 @@ void BrickGrid::releaseMoveIndex(Move& m) {
 // the index, so it runs beside releaseMoveIndex.
 void BrickGrid::releaseMoveBricks(Move& m) {
   BW_ASSERT(m.from_ == this);
-  bricks_.freeMany(m.ids_);
+  // prepareMove found the ids live and distinct; nothing has edited the grid since (this step
+  // is the one that counts the move), so they still are.
+  if (edits_ != m.fromEdits_)
+    throw InvalidInput("BrickGrid::releaseMoveBricks: the grid was edited after prepareMove, or the move was released already");
+  bricks_.freeManyChecked(m.ids_);
   if (bricks_.size() == 0) {
     moments_.clear();
     peakSecond_ = 0;

@@ -154,6 +154,7 @@ class BrickGrid {
     std::vector<uint32_t> ids_, newIds_, elements_;
     std::vector<Brick> bricks_;
     std::vector<Aabb> bounds_;
+    uint64_t fromEdits_ = 0;  // from_'s edit count when prepared: releaseMoveBricks trusts the ids while it holds
   };
   Move prepareMove(std::span<const uint32_t> ids, BrickGrid& into);
   /// Called on the grid the bricks move into: receiveMoveIndex, then receiveMoveBricks.
@@ -245,10 +246,13 @@ class BrickGrid {
   std::vector<uint32_t> placeValidBricks(const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
   /// placeValidBricks with the bricks' ids allocated already (freed again if the build throws):
   /// indexValidBricks, then addValidBricks.
-  void fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
+  void fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
+                       bool boundsFromIndex = false);
   /// The index's bulk load and each id's element handle (the pool's column 1); throws before
-  /// anything changes.
-  void indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
+  /// anything changes. boundsFromIndex: the bounds were read from an index (a move), so the
+  /// index does not check them again.
+  void indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
+                        bool boundsFromIndex = false);
   /// The bricks (column 0) and their mass.
   void addValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks);
   void rebaseIfCancelling();

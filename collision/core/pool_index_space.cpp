@@ -90,6 +90,38 @@ uint32_t PoolIndexSpace::acquire() {
   return slot;
 }
 
+void PoolIndexSpace::acquireMany(uint32_t n, uint32_t* out) {
+  // (acquire() runs out only once every block is full: the same count, checked before any)
+  if (uint64_t(n) > uint64_t(numBlocks_) * slotsPerBlock_ - live_)
+    throw CapacityExceeded(name_ + ": pool exhausted, " + std::to_string(n) + " slots asked for, " +
+                           std::to_string(uint64_t(numBlocks_) * slotsPerBlock_ - live_) + " free");
+  uint32_t done = 0;
+  while (done < n) {
+    const uint32_t b = availableHead_;
+    if (b == kInvalidIndex || meta_[b].freeHead != kInvalidIndex) {
+      out[done++] = acquire();  // a block to start, or a freed slot first: acquire's own order
+      continue;
+    }
+    // The head block has no freed slot, so slots [0, bump) are all live and acquire() would
+    // hand out bump, bump + 1, ... until the block is full or n are taken.
+    BlockMeta& m = meta_[b];
+    const uint32_t first = b * slotsPerBlock_ + m.bump;
+    const uint32_t run = std::min(n - done, slotsPerBlock_ - m.bump);
+    for (uint32_t k = 0; k < run; ++k) out[done + k] = first + k;
+    for (uint32_t slot = first; slot < first + run;) {  // the live bits a word at a time
+      const uint32_t bit = slot & 63, take = std::min(64 - bit, first + run - slot);
+      liveBits_[slot >> 6] |= (take == 64 ? ~uint64_t(0) : ((uint64_t(1) << take) - 1)) << bit;
+      slot += take;
+    }
+    m.bump += run;
+    m.live += run;
+    live_ += run;
+    done += run;
+    if (m.live == slotsPerBlock_) removeAvailable(b);
+    BW_ASSERT(spare_ != b);  // the spare emptied by freeing: its slots are on its free list
+  }
+}
+
 void PoolIndexSpace::requireLive(uint32_t index, const char* operation) const {
   if (!isLive(index))
     throw InvalidInput(name_ + ": " + operation + " of index " + std::to_string(index) +

@@ -35,6 +35,10 @@ class PoolIndexSpace {
 
   /// A free slot index; its column memory is uninitialised. Throws CapacityExceeded when full.
   uint32_t acquire();
+  /// The indices n acquire() calls would give, in their order, into out[0..n), leaving the
+  /// state they leave; a block's untouched slots go as one run (a grid made of a part that broke
+  /// off takes thousands at once). Throws CapacityExceeded, acquiring nothing, if n do not fit.
+  void acquireMany(uint32_t n, uint32_t* out);
   /// Returns a live slot (its elements already destroyed) to its block's free list.
   void release(uint32_t index);
   /// Throws InvalidInput naming the first index that is not live or is listed twice, before

@@ -49,6 +49,12 @@ class ParallelVirtualPool {
     constructAll(i, std::index_sequence_for<Ts...>{});
     return i;
   }
+  /// The handles n allocate() calls would give, in their order (PoolIndexSpace::acquireMany);
+  /// CapacityExceeded, nothing allocated, if n do not fit.
+  void allocateMany(uint32_t n, uint32_t* out) {
+    space_.acquireMany(n, out);
+    for (uint32_t k = 0; k < n; ++k) constructAll(out[k], std::index_sequence_for<Ts...>{});
+  }
   /// Destroys the element's columns and frees its slot. Throws InvalidInput if not live.
   void free(uint32_t i) {
     space_.requireLive(i, "free");
@@ -61,6 +67,13 @@ class ParallelVirtualPool {
   /// ahead, and emptied pages given back in runs (PoolIndexSpace::releaseMany).
   void freeMany(std::span<const uint32_t> handles) {
     space_.requireLiveDistinct(handles, "freeMany");
+    if constexpr (!kTrivial)
+      for (uint32_t i : handles) destroyAll(i, std::index_sequence_for<Ts...>{});
+    space_.releaseMany(handles);
+  }
+  /// freeMany of handles the caller has already shown live and distinct (a bulk removal that
+  /// checked its list before touching anything): the same, without checking them again.
+  void freeManyChecked(std::span<const uint32_t> handles) {
     if constexpr (!kTrivial)
       for (uint32_t i : handles) destroyAll(i, std::index_sequence_for<Ts...>{});
     space_.releaseMany(handles);

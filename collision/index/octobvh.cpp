@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -331,7 +332,7 @@ void OctoBvh::buildItemOf(const ElementRecord& r, uint32_t e, BuildItem& it) {
 
 uint32_t OctoBvh::placeBuilt(uint32_t e) {
   if (!bulk_) return e;
-  const uint32_t h = elements_.allocate();
+  const uint32_t h = bulk_->fresh[bulk_->placed++];
   elements_[h] = ElementRecord::of(bulk_->bounds[e], bulk_->filters[e], bulk_->payloads[e]);
   bulk_->handles[e] = h;
   return h;
@@ -445,6 +446,16 @@ int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {
 
 std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
                                         const std::vector<uint32_t>& payloads) {
+  return bulkLoadChecked(bounds, filters, payloads, true);
+}
+
+std::vector<uint32_t> OctoBvh::bulkLoadValid(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+                                             const std::vector<uint32_t>& payloads) {
+  return bulkLoadChecked(bounds, filters, payloads, false);
+}
+
+std::vector<uint32_t> OctoBvh::bulkLoadChecked(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+                                               const std::vector<uint32_t>& payloads, bool checkBounds) {
   if (!empty()) throw InvalidInput("OctoBvh::bulkLoad: the tree must be empty");
   if (filters.size() != bounds.size() || payloads.size() != bounds.size())
     throw InvalidInput("OctoBvh::bulkLoad: bounds, filters and payloads differ in length (" +
@@ -465,7 +476,7 @@ std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const s
   RootLevelScan scan;
   try {
     for (uint32_t i = 0; i < n; ++i) {  // one pass over the input: checked and itemised
-      validateElement(bounds[i], "OctoBvh::bulkLoad");
+      if (checkBounds) validateElement(bounds[i], "OctoBvh::bulkLoad");
       buildItemOf(ElementRecord::of(bounds[i], 0, 0), i, items[i]);
       scan.add(items[i].minLevel, items[i].ctr);
     }
@@ -475,7 +486,11 @@ std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const s
   }
   rootLevel_ = scan.level();
   clusters_[rootCluster_].level = int8_t(rootLevel_);
-  BulkInput input{bounds.data(), filters.data(), payloads.data(), handles.data()};
+  // The n handles the placements would allocate one by one, in their order, at once (nothing
+  // else allocates elements during the build).
+  const std::unique_ptr<uint32_t[]> fresh(new uint32_t[n]);  // (written whole: not zeroed first)
+  elements_.allocateMany(n, fresh.get());
+  BulkInput input{bounds.data(), filters.data(), payloads.data(), handles.data(), fresh.get(), 0};
   struct BulkScope {  // the build reads bulk_ only while bulkLoad runs
     OctoBvh& tree;
     ~BulkScope() { tree.bulk_ = nullptr; }

@@ -80,6 +80,10 @@ class OctoBvh {
   /// by one). The tree must be empty. Returns the handles in input order.
   std::vector<uint32_t> bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
                                  const std::vector<uint32_t>& payloads);
+  /// bulkLoad of bounds that already passed an OctoBvh's checks (read back from a tree: a grid's
+  /// part moving to a grid of its own), so they are not checked box by box again.
+  std::vector<uint32_t> bulkLoadValid(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+                                      const std::vector<uint32_t>& payloads);
   /// Removes every element.
   void clear();
 
@@ -383,7 +387,11 @@ class OctoBvh {
     const uint32_t* filters;
     const uint32_t* payloads;
     uint32_t* handles;  ///< handles[input] = its element's handle
+    const uint32_t* fresh;  ///< the handles allocated for the build, taken in placement order
+    uint32_t placed;        ///< how many of them are taken
   };
+  std::vector<uint32_t> bulkLoadChecked(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+                                        const std::vector<uint32_t>& payloads, bool checkBounds);
   BulkInput* bulk_ = nullptr;
 };
 

@@ -57,7 +57,7 @@ void OctoBvh::removeMany(std::span<const uint32_t> handles) {
     removeManyAt(rootCluster_, 0, rootCube(), items.data(), uint32_t(items.size()));
     removing_ = nullptr;
     releaseBuildScratch();
-    elements_.freeMany(handles);
+    elements_.freeManyChecked(handles);  // (checked above: live and distinct)
     shrinkRoot();
   }
 }

@@ -570,6 +570,30 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
   }
 }
 
+// A prepared move's last step frees its bricks without checking them again: it refuses, freeing
+// nothing, when the grid was edited after prepareMove (a listed brick may be gone) or when the
+// move was released already.
+TEST(BrickGrid, AMoveIsRefusedOnceTheGridChangedUnderIt) {
+  const std::vector<Brick> bricks = randomBuild(29, 400, Vec3f::Zero());
+  BrickGrid grid;
+  std::vector<uint32_t> ids;
+  for (const Brick& b : bricks) ids.push_back(grid.placeBrick(b));
+  const std::vector<uint32_t> part(ids.begin(), ids.begin() + 150);
+  BrickGrid into;
+  BrickGrid::Move move = grid.prepareMove(part, into);
+  grid.removeBrick(part[17]);  // listed, and now gone
+  EXPECT_THROW(grid.releaseMoveBricks(move), InvalidInput);
+  EXPECT_EQ(grid.brickCount(), bricks.size() - 1) << "nothing freed";
+  BrickGrid into2;
+  std::vector<uint32_t> rest(part);
+  rest.erase(rest.begin() + 17);
+  BrickGrid::Move again = grid.prepareMove(rest, into2);
+  grid.releaseMoveBricks(again);
+  EXPECT_EQ(grid.brickCount(), bricks.size() - 150);
+  EXPECT_THROW(grid.releaseMoveBricks(again), InvalidInput) << "released twice";
+  EXPECT_EQ(grid.brickCount(), bricks.size() - 150);
+}
+
 }  // namespace
 }  // namespace bw
 

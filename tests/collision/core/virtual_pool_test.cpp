@@ -267,6 +267,58 @@ TEST(VirtualPool, FreeManyLeavesWhatFreeingOneByOneLeaves) {
   freeManyEqualsFreeingOneByOne<320>(23, 50'000);
 }
 
+// allocateMany against allocate() one by one on a twin pool, through a seeded history of runs
+// of every size and frees (one at a time and in bulk) that empties blocks, releases them and
+// leaves free lists behind: the same handles in the same order, the same pages resident, and the
+// same handles afterwards; a run that does not fit is refused whole.
+template <size_t N>
+void allocateManyEqualsAllocatingOneByOne(uint64_t seed, uint32_t count) {
+  std::mt19937_64 rng(seed);
+  VirtualPool<Patterned<N>> one(count, "one"), many(count, "many");
+  std::vector<uint32_t> live, run;
+  for (int round = 0; round < 60; ++round) {
+    const uint32_t free = one.capacity() - one.size();
+    const uint32_t n = uint32_t(rng() % 3 == 0 ? rng() % 8 : rng() % std::max<uint32_t>(1, count / 6));
+    if (n > free) {
+      EXPECT_THROW(many.allocateMany(n, run.data()), CapacityExceeded);
+      ASSERT_EQ(many.size(), one.size()) << "a refused run allocates nothing";
+      continue;
+    }
+    run.resize(n);
+    many.allocateMany(n, run.data());
+    for (uint32_t k = 0; k < n; ++k) {
+      const uint32_t a = one.allocate();
+      ASSERT_EQ(run[k], a) << "run of " << n << " in round " << round << ", slot " << k;
+      many[a].fill(a);
+      one[a].fill(a);
+      live.push_back(a);
+    }
+    // Free a random share: some one by one, the rest in bulk, so blocks empty, are released and
+    // keep free lists.
+    std::shuffle(live.begin(), live.end(), rng);
+    const size_t gone = live.size() * (rng() % 90) / 100, single = gone / 3;
+    for (size_t i = 0; i < single; ++i) {
+      one.free(live[i]);
+      many.free(live[i]);
+    }
+    const std::span<const uint32_t> bulk(live.data() + single, gone - single);
+    one.freeMany(bulk);
+    many.freeMany(bulk);
+    live.erase(live.begin(), live.begin() + gone);
+    ASSERT_EQ(many.size(), one.size());
+    ASSERT_EQ(many.residentBytes(), one.residentBytes()) << "round " << round;
+  }
+  for (uint32_t h : live) ASSERT_TRUE(many.isLive(h) && many[h].holds(h)) << h;
+  for (uint32_t i = 0; i < 1000 && one.size() < one.capacity(); ++i) ASSERT_EQ(many.allocate(), one.allocate());
+}
+
+TEST(VirtualPool, AllocateManyHandsOutWhatAllocatingOneByOneDoes) {
+  allocateManyEqualsAllocatingOneByOne<12>(31, 60'000);
+  allocateManyEqualsAllocatingOneByOne<40>(32, 30'000);  // blocks straddle pages
+  allocateManyEqualsAllocatingOneByOne<320>(33, 20'000);
+  allocateManyEqualsAllocatingOneByOne<4100>(34, 3'000);  // one slot a block
+}
+
 TEST(VirtualPool, FreeManyRefusesADeadOrRepeatedHandleWhole) {
   VirtualPool<Patterned<16>> pool(1000, "pool");
   std::vector<uint32_t> ids;
