@@ -234,8 +234,9 @@ void OctoBvh::clearNode(uint32_t c, int s) {
   cl.maxMinLevel[s] = kEmptyMinLevel;
 }
 
-bool OctoBvh::refit(uint32_t c, int s) {
+bool OctoBvh::refit(uint32_t c, int s, NodeSummary* before) {
   NodeCluster& cl = clusters_[c];
+  if (before) *before = {{cl.minX[s], cl.minY[s], cl.minZ[s]}, {cl.maxX[s], cl.maxY[s], cl.maxZ[s]}, cl.filter[s], cl.maxMinLevel[s]};
   // note: min levels grow with an element's largest extent, so the largest min level held is
   // the one of the largest extent: one conversion per refit, not one per element. The merges
   // are Aabb::merge's (std::min(acc, v)), on the record's floats.

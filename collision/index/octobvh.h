@@ -338,7 +338,21 @@ class OctoBvh {
   void releaseBuildScratch();
   void gatherSubtree(uint32_t c, int s, std::vector<uint32_t>& out) const;
   void freeSubtreeClusters(uint32_t cluster);
-  bool refit(uint32_t c, int s);
+  /// What refit computes for a node: its tight bounds, filter bits and largest min level.
+  struct NodeSummary {
+    float lo[3], hi[3];
+    uint32_t filter;
+    int8_t maxMinLevel;
+  };
+  /// Recomputes node (c, s)'s summary from what it holds and its sub clusters' nodes; says
+  /// whether it changed, and gives the one it had in `before` when asked.
+  bool refit(uint32_t c, int s, NodeSummary* before = nullptr);
+  NodeSummary summaryOf(uint32_t c, int s) const;
+  /// Whether node (c, s)'s summary stays as it is when one node it merges (a node of its child
+  /// or forced cluster) changed from `before` to `after`: each face, the filter and the min level
+  /// either did not move, or were not the node's own extreme and did not pass it. Then refitting
+  /// it (reading its 8 or 16 lanes) would change nothing, and nothing above it changes either.
+  bool summaryStays(uint32_t c, int s, const NodeSummary& before, const NodeSummary& after) const;
   void clearNode(uint32_t c, int s);
   uint32_t allocCluster(int level);
 

@@ -165,6 +165,25 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
   }
 }
 
+// The way up an edit: what a refit would find, and whether it needs to run.
+OctoBvh::NodeSummary OctoBvh::summaryOf(uint32_t c, int s) const {
+  const NodeCluster& cl = clusters_[c];
+  return {{cl.minX[s], cl.minY[s], cl.minZ[s]}, {cl.maxX[s], cl.maxY[s], cl.maxZ[s]}, cl.filter[s], cl.maxMinLevel[s]};
+}
+
+bool OctoBvh::summaryStays(uint32_t c, int s, const NodeSummary& before, const NodeSummary& after) const {
+  // note: the comparisons are refit's (float ==, so a face that only changed the sign of a zero
+  // counts as unchanged, as refit's own "changed" does).
+  const NodeSummary node = summaryOf(c, s);
+  for (int k = 0; k < 3; ++k) {
+    if (!(after.lo[k] == before.lo[k] || (before.lo[k] > node.lo[k] && after.lo[k] >= node.lo[k]))) return false;
+    if (!(after.hi[k] == before.hi[k] || (before.hi[k] < node.hi[k] && after.hi[k] <= node.hi[k]))) return false;
+  }
+  if (after.filter != before.filter && ((before.filter & ~after.filter) != 0 || (after.filter & ~node.filter) != 0)) return false;
+  return after.maxMinLevel == before.maxMinLevel ||
+         (before.maxMinLevel < node.maxMinLevel && after.maxMinLevel <= node.maxMinLevel);
+}
+
 // ---------------------------------------------------------------- remove
 
 void OctoBvh::remove(uint32_t handle) {
@@ -237,9 +256,17 @@ bool OctoBvh::updateInPlace(const Placement& old, const Placement& p, const Elem
     s = o;
   }
   elements_[p.e] = moved;
+  // The node holding it is refitted; each node above only if the one below changed in a way
+  // that reaches it (summaryStays).
+  const Step bottom = path[--depth];
+  NodeSummary before;
+  if (!refit(bottom.c, bottom.s, &before)) return true;
+  Step below = bottom;
   while (depth > 0) {
     const Step st = path[--depth];
-    if (!refit(st.c, st.s)) break;
+    if (summaryStays(st.c, st.s, before, summaryOf(below.c, below.s))) break;
+    if (!refit(st.c, st.s, &before)) break;
+    below = st;
   }
   return true;
 }
@@ -333,10 +360,17 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
     s = at.slotBelow(level);
     c = sub;
   }
-  if (changed) changed = refit(c, s);
+  // The way up refits a node when a structure change undone there reshaped it, or when the node
+  // below changed in a way that reaches it (summaryStays): `before` is that node's summary
+  // before its refit.
+  NodeSummary before{};
+  uint32_t belowC = c;
+  int belowS = s;
+  if (changed) changed = refit(c, s, &before);
   while (depth > 0) {
     if (!changed && (undoSteps & ((uint64_t(1) << depth) - 1)) == 0) break;  // nothing left to do above
     const Step st = path[--depth];
+    bool reshaped = false;
     NodeCluster& cl = clusters_[st.c];
     const uint32_t child = cl.child[st.s], forced = cl.forced(st.s);
     if (st.way == kToChildren && forced != kInvalidIndex && clusters_[child].childTotal == 0) {
@@ -346,7 +380,7 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
       n.child[st.s] = forced;
       n.numHeld[st.s] = 0;
       n.leaf[st.s] = kInvalidIndex;
-      changed = true;
+      changed = reshaped = true;
     } else if (st.way == kToForcedCluster && clusters_[forced].childTotal == uint32_t(kLeafCapacity)) {
       // Down to 8 large elements: they are held here again.
       std::vector<uint32_t> big;
@@ -358,10 +392,16 @@ void OctoBvh::removeAt(uint32_t c, int s, Cube cube, const Placement& p) {
       n.leaf[st.s] = kInvalidIndex;
       freeSubtreeClusters(forced);
       for (uint32_t x : big) heldAdd(st.c, st.s, x);
-      changed = true;
+      changed = reshaped = true;
     }
     if (!changed) continue;
-    changed = refit(st.c, st.s);
+    if (!reshaped && summaryStays(st.c, st.s, before, summaryOf(belowC, belowS))) {
+      changed = false;
+      continue;
+    }
+    changed = refit(st.c, st.s, &before);
+    belowC = st.c;
+    belowS = st.s;
   }
 }
 
@@ -377,6 +417,14 @@ void OctoBvh::shrinkRoot() {
     }
     if (root.maxMinLevel[0] > R - 1) return;
     const double half = pow2(R - 1);
+    // Every element then has a half extent of at most half / 2 (its float extent may have been
+    // rounded down by 2^-24 of itself, hence the slack): if the tree's bounds reach past that
+    // beyond the half-size cube, some centre lies outside it. One look at the root instead of a
+    // walk over its two top levels (most removes from a big tree end here).
+    const double reach = 1.5 * half * (1.0 + 0x1p-20);
+    if (root.minX[0] < -reach || root.minY[0] < -reach || root.minZ[0] < -reach || root.maxX[0] > reach ||
+        root.maxY[0] > reach || root.maxZ[0] > reach)
+      return;
     bool fits = true;
     auto heldInside = [&](const NodeCluster& cl, int s) {
       forEachHeld(cl, s, [&](uint32_t e) {
