@@ -178,8 +178,14 @@ void BrickGrid::receiveMoveBricks(Move& m) {
 }
 
 void BrickGrid::releaseMove(Move& m) {
+  requireUnedited(m);  // before either step: a refused move leaves the grid as it was
   releaseMoveIndex(m);
   releaseMoveBricks(m);
+}
+
+void BrickGrid::requireUnedited(const Move& m) const {
+  if (edits_ != m.fromEdits_)
+    throw InvalidInput("BrickGrid::releaseMove: the grid was edited after prepareMove, or the move was released already");
 }
 
 void BrickGrid::releaseMoveIndex(Move& m) {
@@ -193,8 +199,7 @@ void BrickGrid::releaseMoveBricks(Move& m) {
   BW_ASSERT(m.from_ == this);
   // prepareMove found the ids live and distinct; nothing has edited the grid since (this step
   // is the one that counts the move), so they still are.
-  if (edits_ != m.fromEdits_)
-    throw InvalidInput("BrickGrid::releaseMoveBricks: the grid was edited after prepareMove, or the move was released already");
+  requireUnedited(m);
   bricks_.freeManyChecked(m.ids_);
   if (bricks_.size() == 0) {
     moments_.clear();

@@ -141,7 +141,9 @@ class BrickGrid {
   /// receiveMove is itself two steps that touch separate state and may run at the same time:
   /// receiveMoveIndex (the index build, and each brick's element) and receiveMoveBricks (the
   /// bricks and the grid's mass); releaseMove likewise is releaseMoveIndex (the bulk removal)
-  /// and releaseMoveBricks (the bricks and the mass).
+  /// and releaseMoveBricks (the bricks and the mass). The grid the bricks leave must not be
+  /// edited between prepareMove and its release: releaseMove (before either step) and
+  /// releaseMoveBricks refuse with InvalidInput if it was, or if the move was released already.
   class Move {
    public:
     /// The bricks' ids in `into`, in the order of the ids moved (known once prepared).
@@ -256,6 +258,8 @@ class BrickGrid {
   /// The bricks (column 0) and their mass.
   void addValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks);
   void rebaseIfCancelling();
+  /// Throws InvalidInput unless this grid is as prepareMove left it for `m`.
+  void requireUnedited(const Move& m) const;
 };
 
 /// Grid vs grid (article 000): the grid with fewer bricks (of two small ones, the one of smaller

@@ -570,9 +570,9 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
   }
 }
 
-// A prepared move's last step frees its bricks without checking them again: it refuses, freeing
-// nothing, when the grid was edited after prepareMove (a listed brick may be gone) or when the
-// move was released already.
+// A prepared move's last step frees its bricks without checking them again: releaseMove (before
+// either of its steps) and releaseMoveBricks refuse, changing nothing, when the grid was edited
+// after prepareMove (a listed brick may be gone) or when the move was released already.
 TEST(BrickGrid, AMoveIsRefusedOnceTheGridChangedUnderIt) {
   const std::vector<Brick> bricks = randomBuild(29, 400, Vec3f::Zero());
   BrickGrid grid;
@@ -582,8 +582,11 @@ TEST(BrickGrid, AMoveIsRefusedOnceTheGridChangedUnderIt) {
   BrickGrid into;
   BrickGrid::Move move = grid.prepareMove(part, into);
   grid.removeBrick(part[17]);  // listed, and now gone
+  EXPECT_THROW(grid.releaseMove(move), InvalidInput);
+  EXPECT_EQ(grid.index().size(), bricks.size() - 1) << "refused before the index let go of anything";
   EXPECT_THROW(grid.releaseMoveBricks(move), InvalidInput);
   EXPECT_EQ(grid.brickCount(), bricks.size() - 1) << "nothing freed";
+  grid.index().validate();
   BrickGrid into2;
   std::vector<uint32_t> rest(part);
   rest.erase(rest.begin() + 17);
