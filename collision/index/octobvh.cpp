@@ -236,7 +236,7 @@ void OctoBvh::clearNode(uint32_t c, int s) {
 
 bool OctoBvh::refit(uint32_t c, int s, NodeSummary* before) {
   NodeCluster& cl = clusters_[c];
-  if (before) *before = {{cl.minX[s], cl.minY[s], cl.minZ[s]}, {cl.maxX[s], cl.maxY[s], cl.maxZ[s]}, cl.filter[s], cl.maxMinLevel[s]};
+  if (before) *before = summaryOf(c, s);
   // note: min levels grow with an element's largest extent, so the largest min level held is
   // the one of the largest extent: one conversion per refit, not one per element. The merges
   // are Aabb::merge's (std::min(acc, v)), on the record's floats.
@@ -447,15 +447,15 @@ int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {
 
 std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
                                         const std::vector<uint32_t>& payloads) {
-  return bulkLoadChecked(bounds, filters, payloads, true);
+  return bulkLoadCheckingBounds(bounds, filters, payloads, true);
 }
 
 std::vector<uint32_t> OctoBvh::bulkLoadValid(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
                                              const std::vector<uint32_t>& payloads) {
-  return bulkLoadChecked(bounds, filters, payloads, false);
+  return bulkLoadCheckingBounds(bounds, filters, payloads, false);
 }
 
-std::vector<uint32_t> OctoBvh::bulkLoadChecked(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+std::vector<uint32_t> OctoBvh::bulkLoadCheckingBounds(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
                                                const std::vector<uint32_t>& payloads, bool checkBounds) {
   if (!empty()) throw InvalidInput("OctoBvh::bulkLoad: the tree must be empty");
   if (filters.size() != bounds.size() || payloads.size() != bounds.size())

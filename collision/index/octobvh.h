@@ -347,7 +347,10 @@ class OctoBvh {
   /// Recomputes node (c, s)'s summary from what it holds and its sub clusters' nodes; says
   /// whether it changed, and gives the one it had in `before` when asked.
   bool refit(uint32_t c, int s, NodeSummary* before = nullptr);
-  NodeSummary summaryOf(uint32_t c, int s) const;
+  NodeSummary summaryOf(uint32_t c, int s) const {
+    const octobvh::NodeCluster& cl = clusters_[c];
+    return {{cl.minX[s], cl.minY[s], cl.minZ[s]}, {cl.maxX[s], cl.maxY[s], cl.maxZ[s]}, cl.filter[s], cl.maxMinLevel[s]};
+  }
   /// Whether node (c, s)'s summary stays as it is when one node it merges (a node of its child
   /// or forced cluster) changed from `before` to `after`: each face, the filter and the min level
   /// either did not move, or were not the node's own extreme and did not pass it. Then refitting
@@ -404,7 +407,7 @@ class OctoBvh {
     const uint32_t* fresh;  ///< the handles allocated for the build, taken in placement order
     uint32_t placed;        ///< how many of them are taken
   };
-  std::vector<uint32_t> bulkLoadChecked(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
+  std::vector<uint32_t> bulkLoadCheckingBounds(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
                                         const std::vector<uint32_t>& payloads, bool checkBounds);
   BulkInput* bulk_ = nullptr;
 };

@@ -165,12 +165,7 @@ void OctoBvh::insertAt(uint32_t c, int s, Cube cube, const Placement& p) {
   }
 }
 
-// The way up an edit: what a refit would find, and whether it needs to run.
-OctoBvh::NodeSummary OctoBvh::summaryOf(uint32_t c, int s) const {
-  const NodeCluster& cl = clusters_[c];
-  return {{cl.minX[s], cl.minY[s], cl.minZ[s]}, {cl.maxX[s], cl.maxY[s], cl.maxZ[s]}, cl.filter[s], cl.maxMinLevel[s]};
-}
-
+// The way up an edit: whether a node's refit needs to run.
 bool OctoBvh::summaryStays(uint32_t c, int s, const NodeSummary& before, const NodeSummary& after) const {
   // note: the comparisons are refit's (float ==, so a face that only changed the sign of a zero
   // counts as unchanged, as refit's own "changed" does).
