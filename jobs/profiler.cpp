@@ -1,6 +1,7 @@
 #include "jobs/profiler.h"
 
 #include <algorithm>
+#include <climits>
 #include <atomic>
 #include <fstream>
 #include <map>
@@ -98,16 +99,12 @@ double WorkSpan::speedupBound(int threads) const {
 }
 
 namespace {
-struct StageTime {
-  int32_t stage = 0;
-  double work = 0, longest = 0, serial = 0;  // ms: all zones, the longest zone, the serial zones
-};
-
-// A frame's zones summed stage by stage. Zones mostly come stage by stage, and a frame has a
-// few dozen stages: a search of the list from its end finds them. But a coloured island gives a
-// frame thousands of stages, a stage per colour and iteration, where that search was quadratic
-// (28 ms of demolition's 0.4 s run): past kListedStages the stages are found through a hash
-// table. (Sorting every zone by stage instead cost more on frames of few stages and many jobs.)
+// A frame's zones summed stage by stage: a frame has a few dozen stages, or thousands when a
+// coloured island makes a stage of each colour and iteration. Zones of one stage mostly come
+// one after another (checked first); other stages are found through an open-addressing table
+// kept from frame to frame, and sorted once the frame is summed. (Searching a list for each
+// stage was quadratic in them, sorting every zone cost more on frames of many jobs, and a list
+// kept sorted paid a search and an insert per stage: a fifth, then a tenth of stack10's run.)
 class StageSums {
  public:
   void add(const ProfileEvent& e) {
@@ -119,42 +116,58 @@ class StageSums {
     if (e.serial) s.serial += ms;
   }
 
+  /// Sums of the stages added since the last call, in ascending stage order; then starts over.
   WorkSpan workSpan() {
-    std::sort(stages_.begin(), stages_.end(), [](const StageTime& a, const StageTime& b) { return a.stage < b.stage; });
-    index_.clear();  // the slots moved: a later add() finds them by the list again
-    last_ = 0;
+    // Sorted through 8-byte keys (stage, biased so negative ids sort first, and slot).
+    keys_.resize(stages_.size());
+    for (uint32_t k = 0; k < stages_.size(); ++k) keys_[k] = uint64_t(uint32_t(stages_[k].stage) ^ 0x80000000u) << 32 | k;
+    std::sort(keys_.begin(), keys_.end());
     WorkSpan ws;
-    ws.stageWorkMs.reserve(stages_.size());
-    ws.stageSpanMs.reserve(stages_.size());
-    ws.stageIds.reserve(stages_.size());
-    for (const StageTime& s : stages_) {
+    const size_t n = stages_.size();
+    ws.stageWorkMs.resize(n);
+    ws.stageSpanMs.resize(n);
+    ws.stageIds.resize(n);
+    for (size_t k = 0; k < n; ++k) {
+      const StageTime& s = stages_[uint32_t(keys_[k])];
       const double span = std::max(s.longest, s.serial);
       ws.workMs += s.work;
       ws.spanMs += span;
-      ws.stageWorkMs.push_back(s.work);
-      ws.stageSpanMs.push_back(span);
-      ws.stageIds.push_back(s.stage);
+      ws.stageWorkMs[k] = s.work;
+      ws.stageSpanMs[k] = span;
+      ws.stageIds[k] = s.stage;
     }
-    ws.stages = int(stages_.size());
+    ws.stages = int(n);
+    startOver();
     return ws;
   }
 
- private:
-  static constexpr size_t kListedStages = 128;
-  static constexpr uint32_t kEmpty = ~0u;
-  uint32_t slot(int32_t stage) {
-    if (index_.empty()) {
-      for (size_t k = stages_.size(); k-- > 0;)
-        if (stages_[k].stage == stage) return uint32_t(k);
-      stages_.push_back(StageTime{stage});
-      if (stages_.size() > kListedStages) rebuildIndex();
-      return uint32_t(stages_.size() - 1);
+  /// Work and span of the stages added since the last call, in the order first met (no sort,
+  /// no per-stage lists); then starts over.
+  WorkSpanTotals totals() {
+    WorkSpanTotals t;
+    for (const StageTime& s : stages_) {
+      t.workMs += s.work;
+      t.spanMs += std::max(s.longest, s.serial);
     }
+    t.stages = stages_.size();
+    startOver();
+    return t;
+  }
+
+ private:
+  static constexpr uint32_t kEmpty = ~0u;
+  void startOver() {
+    for (const StageTime& s : stages_) index_[s.bucket] = kEmpty;
+    stages_.clear();
+    last_ = 0;
+  }
+  uint32_t slot(int32_t stage) {
+    if (index_.empty()) index_.assign(256, kEmpty);
     const size_t mask = index_.size() - 1;
     for (size_t h = hash(stage) & mask;; h = (h + 1) & mask) {
       if (index_[h] == kEmpty) {
         index_[h] = uint32_t(stages_.size());
-        stages_.push_back(StageTime{stage});
+        stages_.push_back(StageTime{stage, uint32_t(h)});
         if (stages_.size() * 2 > index_.size()) rebuildIndex();
         return uint32_t(stages_.size() - 1);
       }
@@ -162,36 +175,73 @@ class StageSums {
     }
   }
   static size_t hash(int32_t stage) { return size_t((uint64_t(uint32_t(stage)) * 0x9E3779B97F4A7C15ull) >> 32); }
-  // An open-addressing table of stage slots (one allocation, not a node per stage: a frame of
-  // a few hundred stages made a node-based map cost more than the search it replaced).
+  // Twice as large, the frame's stages placed again (one allocation, not a node per stage: a
+  // node-based map cost more than the search it replaced).
   void rebuildIndex() {
-    size_t size = 256;
-    while (size < stages_.size() * 4) size *= 2;
+    const size_t size = index_.size() * 2;
     index_.assign(size, kEmpty);
     for (size_t k = 0; k < stages_.size(); ++k) {
       size_t h = hash(stages_[k].stage) & (size - 1);
       while (index_[h] != kEmpty) h = (h + 1) & (size - 1);
       index_[h] = uint32_t(k);
+      stages_[k].bucket = uint32_t(h);
     }
   }
-  std::vector<StageTime> stages_;
-  std::vector<uint32_t> index_;  // once there are more than kListedStages
+  struct StageTime {
+    int32_t stage = 0;
+    uint32_t bucket = 0;                       // its slot in index_
+    double work = 0, longest = 0, serial = 0;  // ms: all zones, the longest zone, the serial zones
+  };
+  std::vector<StageTime> stages_;  // in the order the frame first met them
+  std::vector<uint32_t> index_;    // open addressing: stages_ slot, or kEmpty
+  std::vector<uint64_t> keys_;
   uint32_t last_ = 0;
 };
+
+// Calls done(sums) after adding each frame 0 .. frames-1's job zones to one StageSums. The zones
+// are grouped by frame with a counting sort, buffer by buffer and each in its order, so a
+// frame's zones are added in the order workSpan(frame) adds them: O(events) and a few
+// allocations, where a StageSums per frame cost ~200 instructions a zone in allocations.
+template <class Buffers, class Done>
+void sumFrameByFrame(const Buffers& buffers, uint32_t frames, int32_t firstStage, int32_t lastStage, Done&& done) {
+  const auto wanted = [&](const ProfileEvent& e) { return e.frame < frames && e.stage >= firstStage && e.stage <= lastStage; };
+  std::vector<uint32_t> firstOfFrame(size_t(frames) + 1, 0);
+  for (const auto& b : buffers)
+    for (const ProfileEvent& e : b->events)
+      if (wanted(e)) ++firstOfFrame[e.frame + 1];
+  for (uint32_t f = 0; f < frames; ++f) firstOfFrame[f + 1] += firstOfFrame[f];
+  std::vector<const ProfileEvent*> byFrame(firstOfFrame[frames]);
+  std::vector<uint32_t> next(firstOfFrame.begin(), firstOfFrame.end() - 1);
+  for (const auto& b : buffers)
+    for (const ProfileEvent& e : b->events)
+      if (wanted(e)) byFrame[next[e.frame]++] = &e;
+  StageSums stages;
+  for (uint32_t f = 0; f < frames; ++f) {
+    for (uint32_t k = firstOfFrame[f]; k < firstOfFrame[f + 1]; ++k) stages.add(*byFrame[k]);
+    done(stages);
+  }
+}
+
 }  // namespace
 
-std::vector<WorkSpan> Profiler::workSpans(uint32_t frames) const {
-  std::vector<StageSums> perFrame(frames);
-  {
-    std::lock_guard<std::mutex> lock(registry_);
-    for (const auto& b : buffers_)
-      for (const ProfileEvent& e : b->events)
-        if (e.frame < frames && e.stage >= 0) perFrame[e.frame].add(e);
-  }
+std::vector<WorkSpan> Profiler::workSpans(uint32_t frames, int32_t firstStage, int32_t lastStage) const {
   std::vector<WorkSpan> out;
   out.reserve(frames);
-  for (StageSums& stages : perFrame) out.push_back(stages.workSpan());
+  std::lock_guard<std::mutex> lock(registry_);
+  sumFrameByFrame(buffers_, frames, std::max(firstStage, 0), lastStage, [&](StageSums& stages) { out.push_back(stages.workSpan()); });
   return out;
+}
+
+WorkSpanTotals Profiler::workSpanTotals(uint32_t frames) const {
+  WorkSpanTotals all;
+  std::lock_guard<std::mutex> lock(registry_);
+  sumFrameByFrame(buffers_, frames, 0, INT32_MAX, [&](StageSums& stages) {
+    const WorkSpanTotals t = stages.totals();
+    all.workMs += t.workMs;
+    all.spanMs += t.spanMs;
+    all.stages += t.stages;
+  });
+  return all;
 }
 
 WorkSpan Profiler::workSpan(uint32_t frame) const {

@@ -15,6 +15,7 @@
 /// Thread safety: zones may be recorded from any thread between beginFrame and endFrame; the
 /// reading functions (events, writeChromeTrace, workSpan) need all zones of the frame closed.
 #include <chrono>
+#include <climits>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -51,6 +52,12 @@ struct WorkSpan {
   std::vector<int32_t> stageIds;  ///< the stage id of each entry above, ascending
 };
 
+/// Work and span summed over frames (what a run reports), without the per-stage lists.
+struct WorkSpanTotals {
+  double workMs = 0, spanMs = 0;
+  uint64_t stages = 0;
+};
+
 class Profiler {
  public:
   Profiler();
@@ -82,8 +89,13 @@ class Profiler {
   /// in ascending order (a world's are).
   WorkSpan workSpan(uint32_t frame) const;
   /// Work/span of frames 0 .. frames-1 in one pass over the events (workSpan per frame would
-  /// read every event once per frame).
-  std::vector<WorkSpan> workSpans(uint32_t frames) const;
+  /// read every event once per frame); of the stages in [firstStage, lastStage] alone when
+  /// given (a render's figures: its few stages summed, not the frame's hundreds).
+  std::vector<WorkSpan> workSpans(uint32_t frames, int32_t firstStage = 0, int32_t lastStage = INT32_MAX) const;
+  /// The same frames' work and span summed (each frame's stages in the order first met, so
+  /// the sums may differ from workSpans()' in the last bits), without per-stage lists: what
+  /// a run reports, for a tenth of workSpans()' instructions on stack10's small frames.
+  WorkSpanTotals workSpanTotals(uint32_t frames) const;
   /// Writes every event as Chrome trace JSON ("X" complete events, microseconds). Throws
   /// std::runtime_error naming the path if the file cannot be written.
   void writeChromeTrace(const std::string& path) const;

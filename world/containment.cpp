@@ -135,6 +135,20 @@ bool World::segmentHitsTerrain(const Vec3d& from, const Vec3d& to) {
   return false;
 }
 
+std::optional<bool> World::segmentHitsBuiltTerrain(const Vec3d& from, const Vec3d& to) const {
+  const double length = (to - from).norm();
+  if (!(length > 0)) return false;
+  const Vec3d dir = (to - from) / length;
+  for (uint32_t g : solidBodies_) {
+    const BodyShape& shape = bodies_.shape[g];
+    if (bodies_.motion[g] == MotionType::Dynamic || !shape.isTerrain()) continue;
+    TerrainRayHit hit;
+    const std::optional<bool> hits = raycastTerrainCached(*terrains_[shape.terrain], from, dir, length, hit);
+    if (!hits || *hits) return hits;
+  }
+  return false;
+}
+
 // A moving solid alone reaching the box: the places of a body there move with it (static
 // ones are the world's).
 uint32_t ContainmentTracker::frameAt(const WorldAabb& box, uint32_t self) const {
@@ -210,9 +224,9 @@ const ContainmentReport& ContainmentTracker::update() {
     state_.push_back(bodies.motion[i] == MotionType::Dynamic ? world_.pointInsideSolid(bodies.position[i], i) : InsideSolid::No);
     hasClear_.push_back(bodies.motion[i] == MotionType::Dynamic && state_.back() == InsideSolid::No);
   }
-  // Pass 1, in parallel: the point test and the crossing test against grids (both only read)
-  // for every body that needs a check; a crossing test against terrain (which fills chunk
-  // caches) is left for pass 2.
+  // Pass 1, in parallel: the point test and the crossing tests against grids and built terrain
+  // chunks (all only read) for every body that needs a check; a crossing test that needs a
+  // terrain chunk not built yet (building fills the chunk cache) is left for pass 2.
   world_.indexSolids();
   movingSolids_ = world_.hasMovingSolid();
   checked_.assign(n, Check::None);
@@ -262,9 +276,18 @@ const ContainmentReport& ContainmentTracker::update() {
       InsideSolid s = world_.pointInsideSolid(p, i, !viaCrossing);
       if (s == InsideSolid::No && hasClear_[i] && crossesGrid(i, p))
         s = viaCrossing && world_.pointInsideSolid(p, i) == InsideSolid::InBrick ? InsideSolid::InBrick : InsideSolid::WentThrough;
-      checked_[i] = s == InsideSolid::InBrick   ? Check::InBrick
-                    : s == InsideSolid::InVoxel ? Check::InVoxel
+      // The crossing test against terrain too, when the chunks it needs are built (it only
+      // reads them then); else pass 2 asks it, building them.
+      bool terrainAsked = false;
+      if (s == InsideSolid::No && hasClear_[i]) {
+        const std::optional<bool> crossed = world_.segmentHitsBuiltTerrain(lastClearWorld_[i], p);
+        terrainAsked = crossed.has_value();
+        if (crossed.value_or(false)) s = InsideSolid::WentThrough;
+      }
+      checked_[i] = s == InsideSolid::InBrick       ? Check::InBrick
+                    : s == InsideSolid::InVoxel     ? Check::InVoxel
                     : s == InsideSolid::WentThrough ? Check::WentThrough
+                    : terrainAsked                  ? Check::Clear
                                                     : Check::ClearOfGrids;
     }
   });
@@ -288,7 +311,8 @@ const ContainmentReport& ContainmentTracker::update() {
                         : checked_[i] == Check::InVoxel ? InsideSolid::InVoxel
                         : checked_[i] == Check::WentThrough ? InsideSolid::WentThrough
                                                               : InsideSolid::No;
-        if (s == InsideSolid::No && hasClear_[i] && world_.segmentHitsTerrain(lastClearWorld_[i], p)) s = InsideSolid::WentThrough;
+        if (checked_[i] == Check::ClearOfGrids && hasClear_[i] && world_.segmentHitsTerrain(lastClearWorld_[i], p))
+          s = InsideSolid::WentThrough;
         if (s == InsideSolid::No) {
           lastClear_[i] = checkPlace_[i];
           clearFrame_[i] = checkFrame_[i];

@@ -69,7 +69,8 @@ class ContainmentTracker {
 
  private:
   // What pass 1 of update() found for a body (pass 2 turns it into state).
-  enum class Check : uint8_t { None, FarFromSolid, InBrick, InVoxel, WentThrough, ClearOfGrids };
+  // ClearOfGrids: its terrain crossing test is left for pass 2; Clear: of everything.
+  enum class Check : uint8_t { None, FarFromSolid, InBrick, InVoxel, WentThrough, ClearOfGrids, Clear };
   // A body's places are kept in the world (kWorldFrame) or in a solid body's frame.
   static constexpr uint32_t kWorldFrame = ~0u;
   uint32_t frameAt(const WorldAabb& box, uint32_t self) const;  // where a body whose way is `box` keeps its places

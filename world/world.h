@@ -26,6 +26,7 @@
 /// between steps.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -203,6 +204,9 @@ class World {
   bool segmentHitsStaticGrid(const Vec3d& from, const Vec3d& to, uint32_t only = kInvalidIndex, uint32_t except = kInvalidIndex) const;
   /// The same against terrains only (fills their chunk caches: one thread, not during step()).
   bool segmentHitsTerrain(const Vec3d& from, const Vec3d& to);
+  /// The same through the terrain chunks already built, reading only (safe on many threads):
+  /// nullopt when an answer needs a chunk not built yet (then ask segmentHitsTerrain).
+  std::optional<bool> segmentHitsBuiltTerrain(const Vec3d& from, const Vec3d& to) const;
   /// The world's job system, for work between steps that reads the world (containment).
   JobSystem& jobs() { return jobs_; }
   /// Whether body `body` came near a grid or terrain body in any substep of the last step: a

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "collision/core/argument_checks.h"
 
@@ -22,10 +23,12 @@ struct RecentChunks {
   void add(uint64_t k) { keys[count++ % 16] = k; }
 };
 
-}  // namespace
-
-bool raycastTerrain(Terrain& terrain, const Vec3d& origin, const Vec3d& dir, double maxDistance, TerrainRayHit& hit,
-                    TerrainRayStats* stats) {
+// The ray walk of raycastTerrain, with chunkAt(c) giving a chunk's collision data (nullptr: not
+// at hand, and the walk gives up: RayWalk::Incomplete).
+enum class RayWalk { Miss, Hit, Incomplete };
+template <class ChunkAt>
+RayWalk walkRay(const Terrain& terrain, const Vec3d& origin, const Vec3d& dir, double maxDistance, TerrainRayHit& hit,
+                TerrainRayStats* stats, ChunkAt&& chunkAt) {
   requireFinite(origin, "raycastTerrain", "origin");
   requireFinite(dir, "raycastTerrain", "dir");
   // note: +inf is a valid maxDistance (an unlimited ray); NaN and negative values are not.
@@ -47,7 +50,7 @@ bool raycastTerrain(Terrain& terrain, const Vec3d& origin, const Vec3d& dir, dou
   float t0 = 0.f, t1 = float(maxDistance);
   for (int i = 0; i < 3; ++i) {
     if (d[i] == 0.f) {
-      if (o[i] < -eps || o[i] > gridMax[i] + eps) return false;
+      if (o[i] < -eps || o[i] > gridMax[i] + eps) return RayWalk::Miss;
       continue;
     }
     float a = (-eps - o[i]) / d[i], b = (gridMax[i] + eps - o[i]) / d[i];
@@ -55,7 +58,7 @@ bool raycastTerrain(Terrain& terrain, const Vec3d& origin, const Vec3d& dir, dou
     t0 = std::max(t0, a);
     t1 = std::min(t1, b);
   }
-  if (!(t0 <= t1)) return false;
+  if (!(t0 <= t1)) return RayWalk::Miss;
 
   // 3D DDA over chunk cells (Amanatides-Woo).
   const Vec3f start = o + d * t0;
@@ -108,7 +111,9 @@ bool raycastTerrain(Terrain& terrain, const Vec3d& origin, const Vec3d& dir, dou
           uint64_t any = 0;
           for (uint64_t s : m->solid) any |= s;
           if (!any) continue;
-          const ChunkCollision& cc = terrain.chunkCollision(c);
+          const ChunkCollision* at = chunkAt(c);
+          if (!at) return RayWalk::Incomplete;
+          const ChunkCollision& cc = *at;
           if (cc.mesh.triangleCount() == 0) continue;
           if (stats) ++stats->chunksTraced;
           const RigidTransform xf = terrain.chunkTransform(c);
@@ -138,7 +143,23 @@ bool raycastTerrain(Terrain& terrain, const Vec3d& origin, const Vec3d& dir, dou
     tEnter = tNext[axis];
     tNext[axis] += tDelta[axis];
   }
-  return found;
+  return found ? RayWalk::Hit : RayWalk::Miss;
+}
+
+}  // namespace
+
+bool raycastTerrain(Terrain& terrain, const Vec3d& origin, const Vec3d& dir, double maxDistance, TerrainRayHit& hit,
+                    TerrainRayStats* stats) {
+  return walkRay(terrain, origin, dir, maxDistance, hit, stats, [&](const Int3& c) { return &terrain.chunkCollision(c); }) ==
+         RayWalk::Hit;
+}
+
+std::optional<bool> raycastTerrainCached(const Terrain& terrain, const Vec3d& origin, const Vec3d& dir, double maxDistance,
+                                         TerrainRayHit& hit) {
+  const RayWalk r = walkRay(terrain, origin, dir, maxDistance, hit, nullptr,
+                            [&](const Int3& c) { return terrain.cachedChunkCollision(c); });
+  if (r == RayWalk::Incomplete) return std::nullopt;
+  return r == RayWalk::Hit;
 }
 
 }  // namespace bw

@@ -1,6 +1,7 @@
 #pragma once
 /// Ray queries against a voxel terrain (world space in, world space out).
 #include <cstdint>
+#include <optional>
 
 #include "collision/terrain/terrain.h"
 
@@ -31,5 +32,12 @@ struct TerrainRayStats {
 /// origin or direction, a zero direction, or a NaN or negative maxDistance.
 bool raycastTerrain(Terrain& terrain, const Vec3d& origin, const Vec3d& dir, double maxDistance, TerrainRayHit& hit,
                     TerrainRayStats* stats = nullptr);
+
+/// The same ray through the chunks the cache holds already, reading only (safe on many threads
+/// while nothing edits the terrain or fills its cache): whether it hits, exactly as
+/// raycastTerrain answers, or nullopt when the walk reached a chunk that would have to be built
+/// first (then raycastTerrain answers).
+std::optional<bool> raycastTerrainCached(const Terrain& terrain, const Vec3d& origin, const Vec3d& dir, double maxDistance,
+                                         TerrainRayHit& hit);
 
 }  // namespace bw

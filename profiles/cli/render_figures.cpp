@@ -25,8 +25,8 @@ void RenderFigures::add(const StepStats& s) {
 void RenderFigures::finish(World& world) {
   sceneHash = world.renderScene().stateHash();
   renderBusyMs = double(world.render()->renderStats().busyNanoseconds) * 1e-6;
-  spans = world.profiler().workSpans(frames);
   renderStage = world.renderStage();
+  spans = world.profiler().workSpans(frames, renderStage, renderStage + kRenderCommitStage);
   mode = world.render()->mode();
 }
 

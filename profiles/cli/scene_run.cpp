@@ -337,10 +337,9 @@ int runScene(const SceneRunOptions& o) {
   const double runS = std::chrono::duration<double>(Clock::now() - tRun).count();
   if (world.render()) render.finish(world);
   // Work and span over the whole run (stages are sequential, each stage's work in one zone here).
-  for (const WorkSpan& ws : world.profiler().workSpans(frames)) {
-    work += ws.workMs;
-    span += ws.spanMs;
-  }
+  const WorkSpanTotals runWorkSpan = world.profiler().workSpanTotals(frames);
+  work += runWorkSpan.workMs;
+  span += runWorkSpan.spanMs;
   if (!o.tracePath.empty()) world.profiler().writeChromeTrace(o.tracePath);
   // `--submission all` adds each mode's render times to the recording before it is closed.
   const auto recordMode = [&](const char* mode, const RenderFigures& f) {

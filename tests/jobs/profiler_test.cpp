@@ -58,7 +58,11 @@ TEST(Profiler, OneFramesWorkSpanEqualsTheWholeRunPassInAnyFrameOrder) {
     for (uint32_t k = 0; k < frames; ++k) {
       const uint32_t f = ascending ? k : (k * 7) % frames;
       p.beginFrame(f);
-      for (uint32_t z = 0; z <= f % 5; ++z) p.record("job", int64_t(k) * 100 + z, int64_t(k) * 100 + z + 1 + f, int32_t(z % 3), z == 2);
+      // Frame 3 has 300 stages (found through StageSums' hash table, which the next frame
+      // summed in the same pass must not inherit).
+      const uint32_t zones = f == 3 ? 300 : f % 5 + 1;
+      for (uint32_t z = 0; z < zones; ++z)
+        p.record("job", int64_t(k) * 1000 + z, int64_t(k) * 1000 + z + 1 + f, int32_t(f == 3 ? z : z % 3), z == 2);
       p.record("outside", 0, 5, -1);
     }
     const std::vector<WorkSpan> all = p.workSpans(frames);
@@ -66,9 +70,37 @@ TEST(Profiler, OneFramesWorkSpanEqualsTheWholeRunPassInAnyFrameOrder) {
       const WorkSpan one = p.workSpan(f);
       EXPECT_DOUBLE_EQ(one.workMs, all[f].workMs) << f;
       EXPECT_DOUBLE_EQ(one.spanMs, all[f].spanMs) << f;
+      EXPECT_EQ(one.stages, all[f].stages) << f;
       EXPECT_GT(one.workMs, 0.0) << f;
     }
     EXPECT_EQ(p.workSpan(frames + 3).workMs, 0.0);
+    // The run's totals: the same sums, stage by stage in another order.
+    double work = 0, span = 0;
+    uint64_t stages = 0;
+    for (const WorkSpan& ws : all) {
+      work += ws.workMs;
+      span += ws.spanMs;
+      stages += uint64_t(ws.stages);
+    }
+    const WorkSpanTotals totals = p.workSpanTotals(frames);
+    EXPECT_NEAR(totals.workMs, work, 1e-12 * work);
+    EXPECT_NEAR(totals.spanMs, span, 1e-12 * span);
+    EXPECT_EQ(totals.stages, stages);
+    EXPECT_EQ(p.workSpanTotals(2).stages, uint64_t(all[0].stages + all[1].stages));
+    // Stages 1 and 2 alone: exactly those entries of the whole frames' figures.
+    const std::vector<WorkSpan> some = p.workSpans(frames, 1, 2);
+    ASSERT_EQ(some.size(), size_t(frames));
+    for (uint32_t f = 0; f < frames; ++f) {
+      std::vector<int32_t> ids;
+      std::vector<double> spans;
+      for (size_t k = 0; k < all[f].stageIds.size(); ++k)
+        if (all[f].stageIds[k] >= 1 && all[f].stageIds[k] <= 2) {
+          ids.push_back(all[f].stageIds[k]);
+          spans.push_back(all[f].stageSpanMs[k]);
+        }
+      EXPECT_EQ(some[f].stageIds, ids) << f;
+      EXPECT_EQ(some[f].stageSpanMs, spans) << f;
+    }
   }
 }
 

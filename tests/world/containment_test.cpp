@@ -129,6 +129,74 @@ TEST(Containment, ShortcutsReportWhatCheckingEveryBodyEveryFrameReports) {
   EXPECT_GE(framesWithBodiesInside, 50u);  // the placed brick and the teleport are seen
 }
 
+// The same against terrain, whose crossing tests run in the parallel pass when the chunks they
+// walk are built and are left for the serial pass when one is not: crates rained onto a quarry
+// (their contacts build the chunks under them), one set straight down under the ground (through
+// built chunks) and one lifted across the quarry and then set down under the ground there
+// (through chunks nothing built yet).
+TEST(Containment, OnTerrainShortcutsReportWhatCheckingEveryBodyEveryFrameReports) {
+  SceneDescription scene;
+  scene.name = "rain_on_quarry";
+  TerrainDescription quarry;
+  quarry.name = "quarry";
+  quarry.generator = "quarry";
+  quarry.size = {40, 40, 20};
+  quarry.seed = 3;
+  scene.terrains.push_back(quarry);
+  SpawnerDescription rain;
+  rain.shape = SpawnerDescription::Shape::Box;
+  rain.count = 60;
+  rain.seed = 4;
+  rain.regionMin = Vec3d(4, 4, 24);
+  rain.regionMax = Vec3d(16, 16, 34);
+  rain.halfExtents = Vec3f::Constant(0.3f);
+  scene.spawners.push_back(rain);
+  World world(scene, 2);
+  ContainmentTracker tracker(world);
+  const BodyStore& bodies = world.bodies();
+  std::vector<Vec3d> lastClear(bodies.position.begin(), bodies.position.end());
+  std::vector<uint8_t> hasClear(bodies.size(), 1);
+  uint32_t framesWithBodiesInside = 0;
+  std::vector<uint32_t> setUnder;
+  for (int f = 0; f < 260; ++f) {
+    if (f == 231) {
+      // The crate lifted last frame, set straight down under the ground far from the rain.
+      std::vector<Vec3d> positions(bodies.position.begin(), bodies.position.end());
+      std::vector<Quatf> rotations(bodies.rotation.begin(), bodies.rotation.end());
+      positions[setUnder.back()].z() = -3;
+      world.setPoses(positions, rotations);
+    } else if (f == 200 || f == 230) {
+      uint32_t body = 0;
+      while (body < bodies.size() && (bodies.motion[body] != MotionType::Dynamic || bodies.linearVelocity[body].norm() > 0.05f ||
+                                      std::find(setUnder.begin(), setUnder.end(), body) != setUnder.end()))
+        ++body;
+      ASSERT_LT(body, bodies.size()) << "no crate at rest at frame " << f;
+      std::vector<Vec3d> positions(bodies.position.begin(), bodies.position.end());
+      std::vector<Quatf> rotations(bodies.rotation.begin(), bodies.rotation.end());
+      positions[body] = f == 200 ? Vec3d(positions[body].x(), positions[body].y(), -3) : Vec3d(32, 30, 30);
+      world.setPoses(positions, rotations);
+      setUnder.push_back(body);
+    } else {
+      world.step();
+    }
+    const ContainmentReport& got = tracker.update();
+    std::vector<uint32_t> expected;
+    for (uint32_t i = 0; i < bodies.size(); ++i) {
+      if (bodies.motion[i] != MotionType::Dynamic) continue;
+      const Vec3d& p = bodies.position[i];
+      InsideSolid s = world.pointInsideSolid(p, i);
+      if (s == InsideSolid::No && hasClear[i] && world.segmentHitsStatic(lastClear[i], p)) s = InsideSolid::WentThrough;
+      if (s == InsideSolid::No) lastClear[i] = p;
+      if (s != InsideSolid::No) expected.push_back(i);
+    }
+    ASSERT_EQ(got.bodies, expected) << "frame " << f;
+    framesWithBodiesInside += expected.empty() ? 0 : 1;
+  }
+  EXPECT_GE(framesWithBodiesInside, 50u);  // both crates set under the ground are seen
+  for (uint32_t body : setUnder)
+    EXPECT_TRUE(std::find(tracker.report().bodies.begin(), tracker.report().bodies.end(), body) != tracker.report().bodies.end()) << body;
+}
+
 // A crate riding a kinematic deck (4 m/s, a wall across the deck behind the crate) is followed
 // in the deck's frame: at rest on it, it is not queried again; the path of a nudge is the path
 // relative to the deck (from its last clear place in world coordinates, that path would cross the

@@ -1,6 +1,7 @@
 #include <cmath>
 #include <gtest/gtest.h>
 #include <limits>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -82,6 +83,49 @@ TEST(TerrainRaycast, ClosestHitMatchesBruteForceOverAllChunks) {
     expectRayMatches(terrain, all, o, d, q % 3 == 0 ? 15.f : 200.f, hits);
   }
   EXPECT_GT(hits, 100);
+}
+
+TEST(TerrainRaycast, TheWalkThroughBuiltChunksAnswersAsTheBuildingWalkOrDefers) {
+  // raycastTerrainCached only reads: it answers exactly as raycastTerrain when every chunk the
+  // walk needs is built, and defers (nullopt) when one is not, building nothing itself.
+  Terrain terrain({40, 24, 40}, 1.f);
+  terrain.edit({0, 0, 0}, {39, 23, 39}, [](VoxelTerrain& v) { generateRandomTerrain(v, 17, 0.02f); });
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> pos(-10.f, 50.f), dir(-1.f, 1.f);
+  int deferred = 0, answeredBefore = 0, hits = 0;
+  for (int q = 0; q < 300; ++q) {
+    const Vec3d o(pos(rng), pos(rng) * 0.5f, pos(rng));
+    Vec3d d(dir(rng), dir(rng), dir(rng));
+    if (d.norm() < 1e-3) d = Vec3d(0, -1, 0);
+    const double maxT = q % 3 == 0 ? 6.0 : 80.0;
+    const size_t cachedBefore = terrain.cache().size();
+    const ChunkCacheStats statsBefore = terrain.cache().stats();
+    TerrainRayHit before, built, after;
+    const std::optional<bool> early = raycastTerrainCached(terrain, o, d, maxT, before);
+    EXPECT_EQ(terrain.cache().size(), cachedBefore);
+    EXPECT_EQ(terrain.cache().stats().misses, statsBefore.misses);
+    EXPECT_EQ(terrain.cache().stats().hits, statsBefore.hits);
+    const bool hit = raycastTerrain(terrain, o, d, maxT, built);
+    if (early) {
+      ++answeredBefore;
+      ASSERT_EQ(*early, hit) << q;
+      if (hit) EXPECT_EQ(before.distance, built.distance) << q;
+    } else {
+      ++deferred;
+      EXPECT_GT(terrain.cache().size(), cachedBefore) << q << ": deferred, yet the building walk built nothing";
+    }
+    const std::optional<bool> late = raycastTerrainCached(terrain, o, d, maxT, after);
+    ASSERT_TRUE(late.has_value()) << q;
+    ASSERT_EQ(*late, hit) << q;
+    if (hit) {
+      ++hits;
+      EXPECT_EQ(after.distance, built.distance) << q;
+      EXPECT_EQ(after.triangle, built.triangle) << q;
+    }
+  }
+  EXPECT_GT(deferred, 20);
+  EXPECT_GT(answeredBefore, 20);
+  EXPECT_GT(hits, 50);
 }
 
 TEST(TerrainRaycast, RaysExactlyAlongChunkBordersAndAxisParallel) {
