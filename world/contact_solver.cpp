@@ -121,7 +121,7 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
   coloured_ = false;  // new contacts: the split islands are coloured again
   const uint32_t n = bodies.size();
   inverseInertiaWorld_.resize(n);
-  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "prepare: inertia", stage);
     for (uint32_t i = begin; i < end; ++i) inverseInertiaWorld_[i] = bodies.inverseInertiaWorld(i);
   });
@@ -166,7 +166,7 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
 void ContactSolver::loadBodies(const BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage) {
   const uint32_t n = bodies.size();
   bodies_.resize(n);
-  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "solver: load bodies", stage);
     for (uint32_t i = begin; i < end; ++i)
       bodies_[i] = {bodies.linearVelocity[i], bodies.inverseMass[i], bodies.angularVelocity[i],
@@ -176,7 +176,7 @@ void ContactSolver::loadBodies(const BodyStore& bodies, JobSystem& jobs, Profile
 
 void ContactSolver::storeBodies(BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage) const {
   const uint32_t n = bodies.size();
-  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "solver: store bodies", stage);
     for (uint32_t i = begin; i < end; ++i) {
       if (!bodies_[i].dynamic) continue;
@@ -443,9 +443,26 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
       smallIslands_.push_back(i);
     }
   }
-  jobs.parallelFor(0, uint32_t(smallIslands_.size()), 1, [&](uint32_t b, uint32_t e) {
+  // Jobs of consecutive islands holding about 1/kTargetJobs of their contacts each (at least
+  // kMinIslandJobContacts); an island that alone reaches that is a job of its own, so the
+  // stage's span stays its largest island. (Which islands share a job changes no result.)
+  uint64_t smallContacts = 0;
+  for (uint32_t i : smallIslands_) smallContacts += islands.contacts(i).size();
+  const uint64_t perJob = std::max<uint64_t>(kMinIslandJobContacts, (smallContacts + tuning::kTargetJobs - 1) / tuning::kTargetJobs);
+  islandJobStart_.clear();
+  uint64_t inJob = 0;
+  for (uint32_t k = 0; k < smallIslands_.size(); ++k) {
+    const uint64_t size = islands.contacts(smallIslands_[k]).size();
+    if (k == 0 || inJob + size > perJob) {
+      islandJobStart_.push_back(k);
+      inJob = 0;
+    }
+    inJob += size;
+  }
+  islandJobStart_.push_back(uint32_t(smallIslands_.size()));
+  jobs.parallelFor(0, uint32_t(islandJobStart_.size() - 1), 1, [&](uint32_t b, uint32_t e) {
     ProfileZone zone(profiler, relax ? "relax" : "island", stage + (relax ? 5 : 3));
-    for (uint32_t i = b; i < e; ++i) solveIsland(islands.contacts(smallIslands_[i]), relax, settings);
+    for (uint32_t i = islandJobStart_[b]; i < islandJobStart_[e]; ++i) solveIsland(islands.contacts(smallIslands_[i]), relax, settings);
   });
   coloured_ = !relax;
   return stats;
