@@ -15,7 +15,6 @@
 /// Thread safety: zones may be recorded from any thread between beginFrame and endFrame; the
 /// reading functions (events, writeChromeTrace, workSpan) need all zones of the frame closed.
 #include <chrono>
-#include <climits>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -93,8 +92,8 @@ class Profiler {
   /// given (a render's figures: its few stages summed, not the frame's hundreds).
   std::vector<WorkSpan> workSpans(uint32_t frames, int32_t firstStage = 0, int32_t lastStage = INT32_MAX) const;
   /// The same frames' work and span summed (each frame's stages in the order first met, so
-  /// the sums may differ from workSpans()' in the last bits), without per-stage lists: what
-  /// a run reports, for a tenth of workSpans()' instructions on stack10's small frames.
+  /// the sums may differ from workSpans()' in the last bits), without per-stage lists or a
+  /// sort per frame: what a run reports.
   WorkSpanTotals workSpanTotals(uint32_t frames) const;
   /// Writes every event as Chrome trace JSON ("X" complete events, microseconds). Throws
   /// std::runtime_error naming the path if the file cannot be written.
