@@ -46,7 +46,7 @@ void World::findPairs() {
     const uint32_t bricks = grids_[bodies_.shape[i].grid]->brickCount();
     return bricks == 0 ? 0 : isStatic_[i] && bricks >= tuning::kCoverMinBricks ? 2 : 1;
   };
-  const uint32_t grain = tuning::lightBodyGrain(n);
+  const uint32_t grain = tuning::bodyGrain(n);
   const uint32_t chunks = JobSystem::chunkCount(0, n, grain);
   proxyChunks_.resize(chunks);
   jobs_.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {

@@ -121,7 +121,7 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
   coloured_ = false;  // new contacts: the split islands are coloured again
   const uint32_t n = bodies.size();
   inverseInertiaWorld_.resize(n);
-  jobs.parallelFor(0, n, tuning::lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "prepare: inertia", stage);
     for (uint32_t i = begin; i < end; ++i) inverseInertiaWorld_[i] = bodies.inverseInertiaWorld(i);
   });
@@ -166,7 +166,7 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
 void ContactSolver::loadBodies(const BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage) {
   const uint32_t n = bodies.size();
   bodies_.resize(n);
-  jobs.parallelFor(0, n, tuning::lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "solver: load bodies", stage);
     for (uint32_t i = begin; i < end; ++i)
       bodies_[i] = {bodies.linearVelocity[i], bodies.inverseMass[i], bodies.angularVelocity[i],
@@ -176,7 +176,7 @@ void ContactSolver::loadBodies(const BodyStore& bodies, JobSystem& jobs, Profile
 
 void ContactSolver::storeBodies(BodyStore& bodies, JobSystem& jobs, Profiler& profiler, int stage) const {
   const uint32_t n = bodies.size();
-  jobs.parallelFor(0, n, tuning::lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "solver: store bodies", stage);
     for (uint32_t i = begin; i < end; ++i) {
       if (!bodies_[i].dynamic) continue;

@@ -68,7 +68,7 @@ void Islands::build(const std::vector<SolverContact>& contacts, const std::vecto
     }
   });
   // Every body points straight at its root (after the join, so no link is still being made).
-  jobs.parallelFor(0, n, tuning::lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "islands: flatten", stage + 1);
     for (uint32_t i = begin; i < end; ++i) std::atomic_ref<uint32_t>(parent_[i]).store(findConcurrent(parent_, i), std::memory_order_relaxed);
   });

@@ -25,7 +25,7 @@ void SleepState::update(BodyStore& bodies, const Islands& islands, float dt, Job
   // Still times grow or restart, and an island with a member not yet ready may not sleep. Each
   // body writes its own still time; a blocked flag is only ever set to 1, so the threads that
   // set the same root's flag agree and the result is the same for any thread count.
-  jobs.parallelFor(0, n, lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "sleep: still times", stage);
     for (uint32_t i = begin; i < end; ++i) {
       if (bodies.motion[i] != MotionType::Dynamic || asleep_[i]) continue;
@@ -35,7 +35,7 @@ void SleepState::update(BodyStore& bodies, const Islands& islands, float dt, Job
     }
   });
   // Every member of an island nobody blocked falls asleep (the join above orders the flags).
-  jobs.parallelFor(0, n, lightBodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  jobs.parallelFor(0, n, bodyGrain(n), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "sleep: islands fall asleep", stage + 1);
     for (uint32_t i = begin; i < end; ++i) {
       if (bodies.motion[i] != MotionType::Dynamic || asleep_[i] || blocked_[islands.root(i)]) continue;

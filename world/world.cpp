@@ -145,7 +145,7 @@ uint64_t World::brickCount() const {
 
 void World::integrate(float dt, int stage) {
   // Each body writes only its own pose: parallel, the same for any thread count.
-  jobs_.parallelFor(0, bodies_.size(), tuning::lightBodyGrain(bodies_.size()), [&](uint32_t begin, uint32_t end) {
+  jobs_.parallelFor(0, bodies_.size(), tuning::bodyGrain(bodies_.size()), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "integrate", stage);
     for (uint32_t i = begin; i < end; ++i) {
       if (bodies_.motion[i] == MotionType::Static || sleep_.asleep(i)) continue;

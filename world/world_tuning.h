@@ -26,13 +26,6 @@ inline constexpr float kDefaultFriction = 0.6f;
 /// (monument) with two or three jobs per stage.
 inline constexpr uint32_t kMinBodyGrain = 32;
 inline constexpr uint32_t bodyGrain(uint32_t bodies) { return grainFor(bodies, kMinBodyGrain); }
-/// Fewest bodies per job of the per-body passes that cost a few nanoseconds a body (traced on
-/// city_rain: storing solver bodies 3 ns, loading them 5, proxies 5, integration 11, world
-/// inertia 12, flattening islands 2): 32 of them made jobs of 0.07-0.4 us, less than scheduling
-/// one, and on two threads those stages took longer than on one (storing bodies 5.2 -> 10.2 ms
-/// over the run). 256 makes a job about a microsecond.
-inline constexpr uint32_t kMinLightBodyGrain = 256;
-inline constexpr uint32_t lightBodyGrain(uint32_t bodies) { return grainFor(bodies, kMinLightBodyGrain); }
 /// Fewest contacts per job of the islands' union-find (a union is a few loads and one
 /// compare-and-swap): 64 (was 256, two jobs for monument's few hundred contacts).
 inline constexpr uint32_t kMinIslandGrain = 64;
