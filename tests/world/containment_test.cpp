@@ -83,6 +83,23 @@ TEST(Containment, ABodyABrickWasPlacedOverIsReportedAsInsideIt) {
   EXPECT_FALSE(world.segmentHitsStatic(Vec3d(50, 10, 1), Vec3d(50, 10, -1)));  // beside it
 }
 
+// The reference the tracker's shortcuts are held to: every dynamic body checked fully (point
+// test, then the path from its last clear place against every static solid); returns the bodies
+// inside solid and moves each clear body's last clear place to where it is.
+std::vector<uint32_t> insideByFullChecks(World& world, std::vector<Vec3d>& lastClear, const std::vector<uint8_t>& hasClear) {
+  const BodyStore& bodies = world.bodies();
+  std::vector<uint32_t> inside;
+  for (uint32_t i = 0; i < bodies.size(); ++i) {
+    if (bodies.motion[i] != MotionType::Dynamic) continue;
+    const Vec3d& p = bodies.position[i];
+    InsideSolid s = world.pointInsideSolid(p, i);
+    if (s == InsideSolid::No && hasClear[i] && world.segmentHitsStatic(lastClear[i], p)) s = InsideSolid::WentThrough;
+    if (s == InsideSolid::No) lastClear[i] = p;
+    if (s != InsideSolid::No) inside.push_back(i);
+  }
+  return inside;
+}
+
 // The tracker's shortcuts (bodies far from solid, bodies at rest, static grids answered by the
 // path) against a reference that checks every dynamic body fully every frame: the same report
 // in every frame, through a rain, a brick placed around a resting body and a body teleported
@@ -114,15 +131,7 @@ TEST(Containment, ShortcutsReportWhatCheckingEveryBodyEveryFrameReports) {
     }
     if (f != 280) world.step();
     const ContainmentReport& got = tracker.update();
-    std::vector<uint32_t> expected;
-    for (uint32_t i = 0; i < bodies.size(); ++i) {
-      if (bodies.motion[i] != MotionType::Dynamic) continue;
-      const Vec3d& p = bodies.position[i];
-      InsideSolid s = world.pointInsideSolid(p, i);
-      if (s == InsideSolid::No && hasClear[i] && world.segmentHitsStatic(lastClear[i], p)) s = InsideSolid::WentThrough;
-      if (s == InsideSolid::No) lastClear[i] = p;
-      if (s != InsideSolid::No) expected.push_back(i);
-    }
+    const std::vector<uint32_t> expected = insideByFullChecks(world, lastClear, hasClear);
     ASSERT_EQ(got.bodies, expected) << "frame " << f;
     framesWithBodiesInside += expected.empty() ? 0 : 1;
   }
@@ -180,15 +189,7 @@ TEST(Containment, OnTerrainShortcutsReportWhatCheckingEveryBodyEveryFrameReports
       world.step();
     }
     const ContainmentReport& got = tracker.update();
-    std::vector<uint32_t> expected;
-    for (uint32_t i = 0; i < bodies.size(); ++i) {
-      if (bodies.motion[i] != MotionType::Dynamic) continue;
-      const Vec3d& p = bodies.position[i];
-      InsideSolid s = world.pointInsideSolid(p, i);
-      if (s == InsideSolid::No && hasClear[i] && world.segmentHitsStatic(lastClear[i], p)) s = InsideSolid::WentThrough;
-      if (s == InsideSolid::No) lastClear[i] = p;
-      if (s != InsideSolid::No) expected.push_back(i);
-    }
+    const std::vector<uint32_t> expected = insideByFullChecks(world, lastClear, hasClear);
     ASSERT_EQ(got.bodies, expected) << "frame " << f;
     framesWithBodiesInside += expected.empty() ? 0 : 1;
   }
