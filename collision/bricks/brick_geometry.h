@@ -61,6 +61,12 @@ class MomentSum {
   void add(const ShapeMoments& m) { accumulate(m, 1.0); }
   void subtract(const ShapeMoments& m) { accumulate(m, -1.0); }
   void clear() { sum_ = comp_ = ShapeMoments{}; }
+  /// Takes another running sum out of this one (its sum and its compensation): what
+  /// subtracting each of its terms would leave, to the same eps^2 of the larger.
+  void subtract(const MomentSum& o) {
+    accumulate(o.sum_, -1.0);
+    accumulate(o.comp_, -1.0);
+  }
   /// The sum with its compensation applied.
   ShapeMoments value() const {
     ShapeMoments v = sum_;

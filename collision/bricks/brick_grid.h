@@ -141,7 +141,10 @@ class BrickGrid {
   /// receiveMove is itself two steps that touch separate state and may run at the same time:
   /// receiveMoveIndex (the index build, and each brick's element) and receiveMoveBricks (the
   /// bricks and the grid's mass); releaseMove likewise is releaseMoveIndex (the bulk removal)
-  /// and releaseMoveBricks (the bricks and the mass). The grid the bricks leave must not be
+  /// and releaseMoveBricks (the bricks and the mass). The moved bricks' moments are summed once,
+  /// by receiveMoveBricks, about this grid's reference point, which `into` takes as its own;
+  /// whichever of receiveMoveBricks and releaseMoveBricks finishes second takes that sum out of
+  /// this grid's mass (so either order, or both at once, still works). The grid the bricks leave must not be
   /// edited between prepareMove and its release: releaseMove (before either step) and
   /// releaseMoveBricks refuse with InvalidInput if it was, or if the move was released already.
   class Move {
@@ -157,6 +160,9 @@ class BrickGrid {
     std::vector<Brick> bricks_;
     std::vector<Aabb> bounds_;
     uint64_t fromEdits_ = 0;  // from_'s edit count when prepared: releaseMoveBricks trusts the ids while it holds
+    Vec3d reference_ = Vec3d::Zero();  // from_'s reference point when prepared (into's from then on)
+    MomentSum moments_;       // the moved bricks' moments about it (receiveMoveBricks)
+    uint32_t massSteps_ = 0;  // receiveMoveBricks and releaseMoveBricks done (atomic_ref: they may run at once)
   };
   Move prepareMove(std::span<const uint32_t> ids, BrickGrid& into);
   /// Called on the grid the bricks move into: receiveMoveIndex, then receiveMoveBricks.
@@ -246,10 +252,9 @@ class BrickGrid {
   float roundingMargin(const Vec3f& queryPoint) const;
   /// placeBricks' work once the bricks are known to be valid and the grid empty.
   std::vector<uint32_t> placeValidBricks(const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
-  /// placeValidBricks with the bricks' ids allocated already (freed again if the build throws):
-  /// indexValidBricks, then addValidBricks.
-  void fillValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
-                       bool boundsFromIndex = false);
+  /// indexValidBricks for ids allocated already, freeing them again if the build throws.
+  void indexValidBricksOrFree(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
+                              bool boundsFromIndex = false);
   /// The index's bulk load and each id's element handle (the pool's column 1); throws before
   /// anything changes. boundsFromIndex: the bounds were read from an index (a move), so the
   /// index does not check them again.
@@ -258,6 +263,9 @@ class BrickGrid {
   /// The bricks (column 0) and their mass.
   void addValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks);
   void rebaseIfCancelling();
+  /// Counts one of a move's two mass steps; the second takes the moved bricks' moments out of
+  /// the grid they left (after both, so neither step waits for the other).
+  static void finishMoveMassStep(Move& m);
   /// Throws InvalidInput unless this grid is as prepareMove left it for `m`.
   void requireUnedited(const Move& m) const;
 };

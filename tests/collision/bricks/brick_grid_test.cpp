@@ -511,9 +511,10 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
     config.density[2] = 3.f;
     const std::vector<Brick> bricks = randomBuild(23, 3000, offset);
     // Cuts 0 and 1 by moveBricks; 2 and 3 the same cuts in steps, the old grid letting go
-    // before the new one is built (an order World may take on two threads).
-    for (int cut = 0; cut < 4; ++cut) {
-      const bool inSteps = cut >= 2;
+    // before the new one is built (an order World may take on two threads); 4 and 5 in steps,
+    // the new grid taking the bricks first (so each of the two mass steps comes second once).
+    for (int cut = 0; cut < 6; ++cut) {
+      const bool inSteps = cut >= 2, newFirst = cut >= 4;
       BrickGrid grid(config), twin(config);
       std::vector<uint32_t> ids;
       for (const Brick& b : bricks) {
@@ -540,10 +541,17 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
         BrickGrid::Move move = grid.prepareMove(part, into);
         EXPECT_EQ(grid.brickCount(), bricks.size()) << "preparing changes nothing";
         // The four steps touch separate state (the world runs them at once): any order.
-        grid.releaseMoveBricks(move);
-        into.receiveMoveBricks(move);
-        grid.releaseMoveIndex(move);
-        into.receiveMoveIndex(move);
+        if (newFirst) {
+          into.receiveMoveIndex(move);
+          into.receiveMoveBricks(move);
+          grid.releaseMoveIndex(move);
+          grid.releaseMoveBricks(move);
+        } else {
+          grid.releaseMoveBricks(move);
+          into.receiveMoveBricks(move);
+          grid.releaseMoveIndex(move);
+          into.receiveMoveIndex(move);
+        }
         moved = move.newIds();
       } else {
         moved = grid.moveBricks(part, into);
