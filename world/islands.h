@@ -41,11 +41,19 @@ class Islands {
 
  private:
   uint32_t find(uint32_t x);
+  /// groupContacts() for fewer contacts than the parallel sort takes: serial, in one zone
+  /// ("islands: group contacts", stage + 1), the same grouping.
+  void groupFewContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, Profiler& profiler,
+                        int stage);
   std::vector<uint32_t> parent_;           // union-find parent per body
   std::vector<uint32_t> start_{0};         // island i's contacts: contacts_[start_[i], start_[i + 1])
   std::vector<uint32_t> contacts_;
   std::vector<uint64_t> keys_;             // groupContacts(): (root << 32 | contact), sorted
   ParallelSorter<uint64_t> keySorter_;
+  // groupFewContacts(): each contact's root, the distinct roots sorted, each root's island
+  // (rootSlot_, valid where rootStamp_ is stamp_), the islands' fill positions.
+  std::vector<uint32_t> contactRoot_, roots_, rootSlot_, rootStamp_, fill_;
+  uint32_t stamp_ = 0;
 };
 
 /// One large island's contacts in colours: no two contacts of a colour share a dynamic body,

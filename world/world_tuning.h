@@ -13,8 +13,16 @@ namespace bw::tuning {
 /// 2000 bodies made two jobs, and every per-body stage stopped scaling at 2x. The cut depends
 /// only on the item count, never on the thread count (determinism).
 inline constexpr uint32_t kTargetJobs = 64;
+/// A stage too small for 64 jobs of its minimum grain still gets up to kFewestJobs (one per
+/// thread at 16), in jobs of no fewer than kSmallestGrain items: a minimum grain of 256 left
+/// monument's 261 bodies and 658 pairs in one or two jobs per stage, and at 8 threads those
+/// single jobs of 3-8 us were a fifth of its work/span bound. Stages whose minimum grain is
+/// kSmallestGrain or less are cut as before.
+inline constexpr uint32_t kFewestJobs = 16;
+inline constexpr uint32_t kSmallestGrain = 32;
 inline constexpr uint32_t grainFor(uint32_t items, uint32_t minGrain) {
-  return std::max(minGrain, (items + kTargetJobs - 1) / kTargetJobs);
+  const uint32_t forFewest = std::max(kSmallestGrain, (items + kFewestJobs - 1) / kFewestJobs);
+  return std::max(std::min(minGrain, forFewest), (items + kTargetJobs - 1) / kTargetJobs);
 }
 
 // --- Bodies -------------------------------------------------------------------------------
