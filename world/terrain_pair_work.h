@@ -43,6 +43,15 @@ struct TerrainPairWork {
   std::vector<Piece> pieces;
   std::vector<PieceOutput> pieceOutputs;   // one per piece (grows, never shrinks)
   std::vector<Vec3f> faceNormals;          // the apply stage's scratch
+  /// select's per-pair and per-chunk counts: a pair's queries (kNoQuery: not a terrain pair
+  /// this substep), a chunk's queries, groups, hulls to make and small grids queried brick by
+  /// brick (entry c + 1 for chunk c, then turned into offsets).
+  static constexpr uint32_t kNoQuery = ~0u;
+  struct SelectChunk {
+    uint32_t queries = 0, groups = 0, hulls = 0, brickwise = 0;
+  };
+  std::vector<uint32_t> pairQueries;
+  std::vector<SelectChunk> selectChunks;
   std::vector<uint8_t> bodyQueried;        // per body: has a query this substep (all 0 between)
   bool bodiesUnique = true;                // no body has two queries (then buoyancy runs per query in parallel)
 };

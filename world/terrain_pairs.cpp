@@ -1,10 +1,12 @@
 // Pairs with a terrain: solid contacts against the chunk triangles, then buoyancy and water
-// drag from the water voxels the body displaces. In six stages:
-//   select (one thread, pair order): the terrain pairs, each one query (a grid's hull is made
-//          here, lazily) or, for a small grid (kBrickwiseGridBricks), one query per brick;
+// drag from the water voxels the body displaces. In eight stages:
+//   select (parallel, per pair): the terrain pairs, each one query or, for a small grid
+//          (kBrickwiseGridBricks), one query per brick, counted per chunk of pairs;
+//   select offsets (one thread): each chunk's offsets; a grid's hull is made here, lazily;
+//   select queries (parallel, per pair): the queries written at their chunk's offsets;
 //   plan   (parallel, per query): the shape, its pose and margin, the candidate triangles from
 //          chunks already in the terrain's cache (TerrainContactPlan only reads), the water;
-//   cut    (one thread): each query's candidates cut into pieces;
+//   cut    (one thread): each query's candidates cut into pieces; whether a body has two;
 //   pieces (parallel, per piece): the contacts of a few candidate triangles each, so a body
 //          lying across many triangles is spread over several jobs;
 //   finish (parallel, per pair): each query's pieces' contacts joined in order, interior
@@ -43,51 +45,92 @@ void World::terrainPairs(float dt) {
   const uint32_t n = uint32_t(pairs_.size());
   const Vec3f g = scene_.settings.gravity.cast<float>();
   stats_.floating = 0;  // bodies in water in the last substep
-  w.queries.clear();
-  w.groups.clear();
-  w.bodiesUnique = true;
-  {
+  // select: each pair's queries counted in parallel (a pair a few nanoseconds: monument's 658
+  // pairs were one serial job of 7 us a substep), offsets taken per chunk, grid hulls made on
+  // one thread (the cache is not thread-safe; rare), then the queries written in parallel, each
+  // chunk at its offset: pair order, as one thread would.
+  const uint32_t selectGrain = grainFor(n, kMinPairGrain);
+  const uint32_t chunks = JobSystem::chunkCount(0, n, selectGrain);
+  w.pairQueries.resize(n);
+  w.selectChunks.assign(chunks + 1, TerrainPairWork::SelectChunk{});
+  jobs_.parallelFor(0, n, selectGrain, [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "terrain: select", stage_ + kTerrainStage);
-    w.bodyQueried.resize(bodies_.size(), 0);
-    for (uint32_t k = 0; k < n; ++k) {
+    TerrainPairWork::SelectChunk counts;
+    for (uint32_t k = begin; k < end; ++k) {
+      w.pairQueries[k] = TerrainPairWork::kNoQuery;
       const uint32_t a = pairs_[k].a, b = pairs_[k].b;
       const bool terrainA = bodies_.shape[a].isTerrain();
       if (!terrainA && !bodies_.shape[b].isTerrain()) continue;
       if (!canCollide(a, b) || (!active(a) && !active(b))) continue;
+      const uint32_t body = terrainA ? b : a;
+      pairFlipped_[k] = body == b;  // normals point from the terrain towards the body
+      uint32_t count = 1;
+      if (bodies_.shape[body].isGrid()) {
+        // A small grid meets terrain brick by brick, each brick the box of its shape (as
+        // against other grids: collideGrids), so a concave piece is not filled in by its hull;
+        // a larger one through its convex approximation (as it meets other grids).
+        const BrickGrid& grid = *grids_[bodies_.shape[body].grid];
+        if (grid.brickCount() <= kBrickwiseGridBricks) {
+          count = grid.brickCount();
+          ++counts.brickwise;
+        } else {
+          ++counts.hulls;
+        }
+      }
+      w.pairQueries[k] = count;
+      counts.queries += count;
+      ++counts.groups;
+    }
+    w.selectChunks[begin / selectGrain + 1] = counts;  // (offsets: summed below)
+  });
+  {
+    ProfileZone z(profiler_, "terrain: select offsets", stage_ + kTerrainStage + 1);
+    w.bodiesUnique = true;  // (a small grid's bricks are queries of one body)
+    for (uint32_t c = 0; c < chunks; ++c) {
+      TerrainPairWork::SelectChunk& next = w.selectChunks[c + 1];
+      w.bodiesUnique &= next.brickwise == 0;
+      const bool hulls = next.hulls != 0;
+      next.queries += w.selectChunks[c].queries;
+      next.groups += w.selectChunks[c].groups;
+      if (!hulls) continue;
+      // Made here, on one thread, the first time it is needed.
+      for (uint32_t k = c * selectGrain; k < std::min(n, (c + 1) * selectGrain); ++k) {
+        if (w.pairQueries[k] != 1) continue;
+        const uint32_t body = pairFlipped_[k] ? pairs_[k].b : pairs_[k].a;
+        if (!bodies_.shape[body].isGrid()) continue;
+        BrickGrid& grid = *grids_[bodies_.shape[body].grid];
+        if (grid.brickCount() > kBrickwiseGridBricks) grid.convexApproximation(scene_.settings.approximationDepth);
+      }
+    }
+    w.queries.resize(w.selectChunks[chunks].queries);
+    w.groups.resize(w.selectChunks[chunks].groups);
+  }
+  jobs_.parallelFor(0, n, selectGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler_, "terrain: select queries", stage_ + kTerrainStage + 2);
+    uint32_t at = w.selectChunks[begin / selectGrain].queries, group = w.selectChunks[begin / selectGrain].groups;
+    for (uint32_t k = begin; k < end; ++k) {
+      const uint32_t count = w.pairQueries[k];
+      if (count == TerrainPairWork::kNoQuery) continue;
       TerrainPairWork::Query q;
       q.pair = k;
-      q.body = terrainA ? b : a;
-      q.terrain = bodies_.shape[terrainA ? a : b].terrain;
-      pairFlipped_[k] = q.body == b;  // normals point from the terrain towards the body
-      w.bodiesUnique &= w.bodyQueried[q.body] == 0;
-      w.bodyQueried[q.body] = 1;
-      w.groups.push_back({k, uint32_t(w.queries.size()), 1});
-      if (bodies_.shape[q.body].isGrid()) {
-        BrickGrid& grid = *grids_[bodies_.shape[q.body].grid];
-        if (grid.brickCount() <= kBrickwiseGridBricks) {
-          // A small grid meets terrain brick by brick, each brick the box of its shape (as
-          // against other grids: collideGrids), so a concave piece is not filled in by its hull.
-          w.groups.back().queryCount = 0;
-          w.bodiesUnique = false;
-          grid.forEachBrick([&](uint32_t id) {
-            q.brick = id;
-            w.queries.push_back(q);
-            ++w.groups.back().queryCount;
-          });
-          continue;
-        }
-        // A larger one through its convex approximation (as it meets other grids), made here,
-        // on one thread, the first time it is needed.
-        grid.convexApproximation(scene_.settings.approximationDepth);
+      q.body = pairFlipped_[k] ? pairs_[k].b : pairs_[k].a;
+      q.terrain = bodies_.shape[pairFlipped_[k] ? pairs_[k].a : pairs_[k].b].terrain;
+      w.groups[group++] = {k, at, count};
+      const BodyShape& shape = bodies_.shape[q.body];
+      if (shape.isGrid() && grids_[shape.grid]->brickCount() <= kBrickwiseGridBricks) {
+        grids_[shape.grid]->forEachBrick([&](uint32_t id) {
+          q.brick = id;
+          w.queries[at++] = q;
+        });
+        continue;
       }
-      w.queries.push_back(q);
+      w.queries[at++] = q;
     }
-    for (const TerrainPairWork::Query& q : w.queries) w.bodyQueried[q.body] = 0;
-  }
+  });
   const uint32_t m = uint32_t(w.queries.size());
   if (w.plans.size() < m) w.plans.resize(m);
   jobs_.parallelFor(0, m, grainFor(m, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
-    ProfileZone z(profiler_, "terrain: plan", stage_ + kTerrainStage + 1);
+    ProfileZone z(profiler_, "terrain: plan", stage_ + kTerrainStage + 3);
     for (uint32_t i = begin; i < end; ++i) {
       TerrainPairWork::Query& q = w.queries[i];
       const BodyPair& p = pairs_[q.pair];
@@ -110,21 +153,26 @@ void World::terrainPairs(float dt) {
   });
   {
     // Cut each planned query's candidates into pieces (a few microseconds of work each).
-    ProfileZone z(profiler_, "terrain: cut", stage_ + kTerrainStage + 2);
+    ProfileZone z(profiler_, "terrain: cut", stage_ + kTerrainStage + 4);
     w.pieces.clear();
+    w.bodyQueried.resize(bodies_.size(), 0);
     for (uint32_t i = 0; i < m; ++i) {
       TerrainPairWork::Query& q = w.queries[i];
+      // Buoyancy runs per query in parallel (finish) when no body has two queries.
+      w.bodiesUnique &= w.bodyQueried[q.body] == 0;
+      w.bodyQueried[q.body] = 1;
       q.firstPiece = uint32_t(w.pieces.size());
       const uint32_t count = q.cached ? w.plans[i].triangleCount() : 0;
       const uint32_t per = trianglesPerPiece(q.shape);
       for (uint32_t t = 0; t < count; t += per) w.pieces.push_back({i, t, std::min(count, t + per)});
       q.pieceCount = uint32_t(w.pieces.size()) - q.firstPiece;
     }
+    for (const TerrainPairWork::Query& q : w.queries) w.bodyQueried[q.body] = 0;
   }
   const uint32_t pieceCount = uint32_t(w.pieces.size());
   if (w.pieceOutputs.size() < pieceCount) w.pieceOutputs.resize(pieceCount);
   jobs_.parallelFor(0, pieceCount, grainFor(pieceCount, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
-    ProfileZone z(profiler_, "terrain pairs", stage_ + kTerrainStage + 3);
+    ProfileZone z(profiler_, "terrain pairs", stage_ + kTerrainStage + 5);
     for (uint32_t i = begin; i < end; ++i) {
       const TerrainPairWork::Piece& piece = w.pieces[i];
       TerrainPairWork::PieceOutput& o = w.pieceOutputs[i];
@@ -172,7 +220,7 @@ void World::terrainPairs(float dt) {
   };
   const uint32_t groupCount = uint32_t(w.groups.size());
   jobs_.parallelFor(0, groupCount, grainFor(groupCount, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
-    ProfileZone z(profiler_, "terrain: finish", stage_ + kTerrainStage + 4);
+    ProfileZone z(profiler_, "terrain: finish", stage_ + kTerrainStage + 6);
     // note: thread_local scratch: the face normals of one query, joined from its pieces.
     thread_local std::vector<Vec3f> faceNormals;
     for (uint32_t g = begin; g < end; ++g) {
@@ -186,7 +234,7 @@ void World::terrainPairs(float dt) {
       if (group.queryCount > 1) reduceManifold(out, 0, scene_.settings.manifoldSize);  // a small grid's bricks: one manifold
     }
   });
-  ProfileZone z(profiler_, "terrain: apply", stage_ + kTerrainStage + 5);
+  ProfileZone z(profiler_, "terrain: apply", stage_ + kTerrainStage + 7);
   std::vector<Vec3f>& faceNormals = w.faceNormals;
   for (const TerrainPairWork::Group& group : w.groups) {
     std::vector<Contact>& out = pairContacts_[group.pair];

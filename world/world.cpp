@@ -400,9 +400,10 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   // its build (Split_CutInTwo, 50k bricks: 17 -> 12 ms). note: tried before the removal gave its
   // emptied pages back in runs (PoolIndexSpace::DeferPageRelease), this was slower than one
   // thread: a madvise per emptied block, each flushing the TLB of the core that was building.
-  // The build goes first and the part's mass second: oneTBB's halves give one thread both
-  // (33 + 15 M instructions for a 50k-brick half) while the other takes the old grid's two
-  // (24 + 18 M) and the links (9 M); with four threads or more the build alone is the longest.
+  // The build goes first and the part's bricks and mass second: oneTBB's halves give one thread
+  // both (29 + 15 M instructions for a 50k-brick half) while the other takes the old grid's two
+  // (22 + 3 M: the part's moments are summed once, by the part) and the links (9 M); with four
+  // threads or more the build alone is the longest.
   constexpr uint32_t kSteps = 5;
   const auto step = [&](uint32_t k) {
     if (k == 0) grid->receiveMoveIndex(move);

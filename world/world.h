@@ -326,14 +326,14 @@ class World {
   // sleeping's two passes (7, 8), the solver's preparation (9: inertia, 10: contacts), islands (11:
   // union, 12: flatten), broadphase proxies' offsets (13) and written (14), the broadphase
   // (kBroadphaseStage, its kStages), terrain pairs
-  // (kTerrainStage: select, plan, cut, pieces, finish, apply), the pair cache and the other steps between
+  // (kTerrainStage: select, its offsets and queries, plan, cut, pieces, finish, apply), the pair cache and the other steps between
   // (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded, stored after
   // the solve and after the relax, counters; then + 8 .. + 13 contacts grouped by island;
   // + 14 .. + 18 the impulses kept for the next substep's warm start: copied, then sorted).
   // Every piece of a substep's work is in one of them: work/span sees the whole step.
   static constexpr int kBroadphaseStage = 15;
   static constexpr int kTerrainStage = kBroadphaseStage + IncrementalBroadphase::kStages;
-  static constexpr int kContactStepsStage = kTerrainStage + 6;
+  static constexpr int kContactStepsStage = kTerrainStage + 8;
   static constexpr int kStagesPerSubstep = kContactStepsStage + 19;
 
   SceneDescription scene_;

@@ -144,8 +144,9 @@ class BrickGrid {
   /// and releaseMoveBricks (the bricks and the mass). The moved bricks' moments are summed once,
   /// by receiveMoveBricks, about this grid's reference point, which `into` takes as its own;
   /// whichever of receiveMoveBricks and releaseMoveBricks finishes second takes that sum out of
-  /// this grid's mass (so either order, or both at once, still works). The grid the bricks leave must not be
-  /// edited between prepareMove and its release: releaseMove (before either step) and
+  /// this grid's mass (so either order, or both at once, still works: this grid's mass is
+  /// current once both have run). The grid the bricks leave must not be edited between
+  /// prepareMove and its release: releaseMove (before either step) and
   /// releaseMoveBricks refuse with InvalidInput if it was, or if the move was released already.
   class Move {
    public:
