@@ -17,7 +17,8 @@ inline constexpr uint32_t kTargetJobs = 64;
 /// thread at 16), in jobs of no fewer than kSmallestGrain items: a minimum grain of 256 left
 /// monument's 261 bodies and 658 pairs in one or two jobs per stage, and at 8 threads those
 /// single jobs of 3-8 us were a fifth of its work/span bound. Stages whose minimum grain is
-/// kSmallestGrain or less are cut as before.
+/// kSmallestGrain or less are cut as before. So a stage's "fewest items per job" (the kMin*Grain
+/// constants) holds once it has kFewestJobs jobs; below that, jobs go down to kSmallestGrain.
 inline constexpr uint32_t kFewestJobs = 16;
 inline constexpr uint32_t kSmallestGrain = 32;
 inline constexpr uint32_t grainFor(uint32_t items, uint32_t minGrain) {

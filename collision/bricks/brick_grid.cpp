@@ -180,20 +180,15 @@ void BrickGrid::receiveMoveIndex(Move& m) {
 // and summed twice, 29 M of a 50k-brick cut's 111 M instructions (Split_CutInTwo).
 void BrickGrid::receiveMoveBricks(Move& m) {
   BW_ASSERT(m.into_ == this);
-  // (this grid was empty: prepareMove checked)
-  for (size_t i = 0; i < m.bricks_.size(); ++i) {
-    const Brick& b = m.bricks_[i];
-    bricks_.get<0>(m.newIds_[i]) = b;
-    moments_.add(brickMoments(b, config_.density[b.material], m.reference_));
-  }
-  m.moments_ = moments_;
+  // (this grid was empty: prepareMove checked) Its reference is the old grid's, so the sum
+  // addValidBricks makes here is the part's sum about it.
   if (!m.bricks_.empty()) {
     reference_ = m.reference_;
     referenceSet_ = true;
-    peakSecond_ = moments_.value().second.trace();
-    rebaseIfCancelling();  // a small part far from the old grid's reference point
   }
-  ++edits_;
+  addValidBricks(m.newIds_, m.bricks_);
+  m.moments_ = moments_;
+  rebaseIfCancelling();  // a small part far from the old grid's reference point
   finishMoveMassStep(m);
 }
 
