@@ -210,9 +210,12 @@ inline std::array<uint8_t, 8> OctoBvh::rayChildOrder(const Vec3f& dir) {
   // Axes by decreasing |dir|: the major axis gets the most significant bit of the visit counter,
   // so all four children on the near side of the major split come first. Each bit is flipped
   // for axes the ray travels down (negative component), making "near" bit value 0.
+  // Ties keep the lower axis first. note: an insertion sort by hand, not std::stable_sort, which
+  // asks the heap for a buffer: that was a fifth of a short containment ray's instructions.
   int axis[3] = {0, 1, 2};
   const float mag[3] = {std::abs(dir.x()), std::abs(dir.y()), std::abs(dir.z())};
-  std::stable_sort(axis, axis + 3, [&](int a, int b) { return mag[a] > mag[b]; });
+  for (int i = 1; i < 3; ++i)
+    for (int j = i; j > 0 && mag[axis[j]] > mag[axis[j - 1]]; --j) std::swap(axis[j], axis[j - 1]);
   std::array<uint8_t, 8> order{};
   for (int k = 0; k < 8; ++k) {
     int slot = 0;

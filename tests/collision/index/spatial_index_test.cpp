@@ -639,6 +639,25 @@ TEST(OctoBvh, MemoryGoesBackWhenEmptiedInRandomOrder) {
   tree.validate();
 }
 
+TEST(OctoBvh, RayChildOrderRanksAxesByMagnitudeWithTiesInAxisOrder) {
+  // The visit order decides which of two hits at equal t a traversal meets first, so it must not
+  // change with how the axes are ranked: against std::stable_sort's ranking, on random
+  // directions and on directions whose components tie in magnitude (and in sign or not).
+  SeededRandom r(5);
+  const float values[] = {0.f, 1.f, -1.f, 0.5f, -0.5f, 2.f};
+  for (int i = 0; i < 3000; ++i) {
+    Vec3f d;
+    for (int k = 0; k < 3; ++k) d[k] = i < 1500 ? values[r.below(6)] : float(r.normal());
+    int axis[3] = {0, 1, 2};
+    std::stable_sort(axis, axis + 3, [&](int a, int b) { return std::abs(d[a]) > std::abs(d[b]); });
+    std::array<uint8_t, 8> expected{};
+    for (int k = 0; k < 8; ++k)
+      for (int rank = 0; rank < 3; ++rank)
+        expected[k] |= uint8_t((((k >> (2 - rank)) & 1) ^ (d[axis[rank]] < 0.f ? 1 : 0)) << axis[rank]);
+    ASSERT_EQ(OctoBvh::rayChildOrder(d), expected) << d.transpose();
+  }
+}
+
 TEST(OctoBvh, RayChildOrderIsFrontToBack) {
   // For every direction, a child visited later is never strictly nearer on every axis.
   SeededRandom r(4);
