@@ -148,7 +148,7 @@ void World::terrainPairs(float dt) {
       q.margin = tuning::kSpeculativeMargin + closingSpeed(q.body, q.body == p.a ? p.b : p.a) * dt;
       const Terrain& terrain = *terrains_[q.terrain];
       q.cached = w.plans[i].plan(terrain, q.shape, q.pose, q.margin);
-      q.wet = bodies_.motion[q.body] == MotionType::Dynamic && terrainWaterContact(terrain, q.shape, q.pose, q.water);
+      q.wet = bodies_.motion[q.body] == MotionType::Dynamic && terrainWaterContactChecked(terrain, q.shape, q.pose, q.water);
     }
   });
   {

@@ -381,13 +381,46 @@ bool terrainContactsCached(const Terrain& terrain, const QueryShape& shape, cons
   return contactsWith(terrain, shape, pose, spec, out, [&](const Int3& chunk) { return terrain.cachedChunkCollision(chunk); });
 }
 
+namespace {
+
+// One axis of the water sum: the overlap of each cell [v * vs, v * vs + vs) with the box's
+// [boxMin, boxMax), and its midpoint, with the operations the sum per voxel used (the cell's
+// min and max against the box's, then difference and half sum), so every voxel's terms are the
+// same floats: computed once per column instead of once per voxel.
+struct CellOverlap {
+  float length = 0.f, mid = 0.f;
+  bool empty = true;
+};
+
+CellOverlap cellOverlap(float cellMin, float cellMax, float boxMin, float boxMax) {
+  const float lo = std::max(cellMin, boxMin), hi = std::min(cellMax, boxMax);  // Eigen's cwiseMax / cwiseMin
+  CellOverlap o;
+  o.empty = lo >= hi;
+  o.length = hi - lo;
+  o.mid = (lo + hi) * 0.5f;
+  return o;
+}
+
+void cellOverlaps(int first, int last, float vs, float boxMin, float boxMax, std::vector<CellOverlap>& out) {
+  out.resize(size_t(last - first + 1));
+  for (int v = first; v <= last; ++v) {
+    const float cellMin = float(v) * vs;
+    out[size_t(v - first)] = cellOverlap(cellMin, cellMin + vs, boxMin, boxMax);
+  }
+}
+
+}  // namespace
+
 bool terrainWaterContact(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out) {
   validatePlacedShape(shape, pose, "terrainWaterContact");
+  return terrainWaterContactChecked(terrain, shape, pose, out);
+}
+
+bool terrainWaterContactChecked(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out) {
   out = {};
   const RigidTransform& place = terrain.placement();
   const LocalShape ls = placeShape(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation));
   const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds);
-  if (!terrain.overlapLocal(box).water) return false;
   const float vs = terrain.voxelSize();
   const Int3 size = terrain.voxels().size();
   int lo[3], hi[3];
@@ -396,43 +429,77 @@ bool terrainWaterContact(const Terrain& terrain, const QueryShape& shape, const 
     lo[i] = int(std::clamp(std::floor(double(box.min[i]) / vs), 0.0, double(n - 1)));
     hi[i] = int(std::clamp(std::floor(double(box.max[i]) / vs), 0.0, double(n - 1)));
   }
-  // note: the chunks of one layer of chunks are looked up once, not one key lookup per voxel
-  // (VoxelTerrain::get was a tenth of monument's run), and a chunk without water skips its
-  // voxels, which add nothing. The voxels still come in y, z, x order: the same sums, bit for bit.
+  // note: no broadphase test first: chunks without water are skipped below (a lookup per chunk
+  // of a layer), and the bitmask test cost more than the sum for a body in the water (a quarter
+  // of monument's terrain work). The chunks of one layer are looked up once, not one key lookup
+  // per voxel. The voxels still come in y, z, x order, each term the same floats: the same sums,
+  // bit for bit.
   const int cx0 = lo[0] >> kChunkShift, cz0 = lo[2] >> kChunkShift;
   const int nx = (hi[0] >> kChunkShift) - cx0 + 1, nz = (hi[2] >> kChunkShift) - cz0 + 1;
   thread_local std::vector<const VoxelChunk*> layer;  // [z][x]: the current y layer's chunks that hold water
+  thread_local std::vector<CellOverlap> alongX, alongZ;
   layer.resize(size_t(nx) * size_t(nz));
+  cellOverlaps(lo[0], hi[0], vs, box.min.x(), box.max.x(), alongX);
+  cellOverlaps(lo[2], hi[2], vs, box.min.z(), box.max.z(), alongZ);
   int layerY = -1;
+  bool anyWater = false;
   double volume = 0;
   Vec3d moment = Vec3d::Zero();
   for (int y = lo[1]; y <= hi[1]; ++y) {
     if ((y >> kChunkShift) != layerY) {
       layerY = y >> kChunkShift;
+      anyWater = false;
       for (int cz = 0; cz < nz; ++cz)
         for (int cx = 0; cx < nx; ++cx) {
           const VoxelChunk* c = terrain.voxels().chunk({cx0 + cx, layerY, cz0 + cz});
           layer[size_t(cz) * size_t(nx) + size_t(cx)] = c && c->waterCount ? c : nullptr;
+          anyWater |= c && c->waterCount;
         }
     }
+    if (!anyWater) {
+      y |= kChunkSize - 1;  // on to the next layer of chunks
+      continue;
+    }
+    // The filled part of a cell: occupancy/255 of its height, from the bottom (a full cell's
+    // overlap computed once per row).
+    const float cellMinY = float(y) * vs;
+    const CellOverlap fullY = cellOverlap(cellMinY, cellMinY + vs * 255.f / 255.f, box.min.y(), box.max.y());
     for (int z = lo[2]; z <= hi[2]; ++z) {
+      const CellOverlap& oz = alongZ[size_t(z - lo[2])];
+      if (oz.empty) continue;
+      // note: Eigen's prod() of a 3-vector is x * (y * z) (WaterSumsEqualAVoxelByVoxelReference
+      // holds us to its bits), so a full cell's y * z is the row's.
+      const float fullYZ = fullY.length * oz.length;
       const VoxelChunk* const* row = &layer[size_t((z >> kChunkShift) - cz0) * size_t(nx)];
-      for (int x = lo[0]; x <= hi[0]; ++x) {
+      const int inChunk = chunkVoxelIndex(0, y & (kChunkSize - 1), z & (kChunkSize - 1));
+      for (int x = lo[0]; x <= hi[0];) {
         const VoxelChunk* c = row[(x >> kChunkShift) - cx0];
+        const int end = std::min(hi[0], x | (kChunkSize - 1));  // this chunk's part of the row
         if (!c) {
-          x |= kChunkSize - 1;  // on to the next chunk
+          x = end + 1;
           continue;
         }
-        const Voxel v = c->voxels[chunkVoxelIndex(x & (kChunkSize - 1), y & (kChunkSize - 1), z & (kChunkSize - 1))];
-        if (!v.isWater()) continue;
-        // The filled part of the cell: occupancy/255 of its height, from the bottom.
-        const Vec3f cellMin(float(x) * vs, float(y) * vs, float(z) * vs);
-        const Vec3f cellMax(cellMin.x() + vs, cellMin.y() + vs * float(v.occupancy) / 255.f, cellMin.z() + vs);
-        const Vec3f omin = cellMin.cwiseMax(box.min), omax = cellMax.cwiseMin(box.max);
-        if ((omin.array() >= omax.array()).any()) continue;
-        const double ov = double((omax - omin).prod());
-        volume += ov;
-        moment += ov * ((omin + omax) * 0.5f).cast<double>();
+        const Voxel* voxels = c->voxels + inChunk;
+        for (; x <= end; ++x) {
+          const Voxel v = voxels[x & (kChunkSize - 1)];
+          if (!v.isWater()) continue;
+          const CellOverlap& ox = alongX[size_t(x - lo[0])];
+          if (ox.empty) continue;
+          double ov;
+          float midY;
+          if (v.occupancy == 255) {
+            if (fullY.empty) continue;
+            ov = double(ox.length * fullYZ);
+            midY = fullY.mid;
+          } else {
+            const CellOverlap oy = cellOverlap(cellMinY, cellMinY + vs * float(v.occupancy) / 255.f, box.min.y(), box.max.y());
+            if (oy.empty) continue;
+            ov = double(ox.length * (oy.length * oz.length));
+            midY = oy.mid;
+          }
+          volume += ov;
+          moment += ov * Vec3f(ox.mid, midY, oz.mid).cast<double>();
+        }
       }
     }
   }

@@ -121,7 +121,10 @@ struct WaterContact {
 /// Estimates the water volume the shape displaces: the overlap of the shape's terrain-local
 /// bounding box with each water voxel's filled part (occupancy / 255 of the cell from its
 /// bottom), scaled by shape volume / box volume (exact for an axis-aligned box, an estimate
-/// otherwise). Returns false when the broadphase sees no water.
+/// otherwise). Returns false when no water voxel overlaps the box.
 bool terrainWaterContact(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out);
+/// terrainWaterContact for a shape and pose the caller has checked already (validatePlacedShape,
+/// as terrainContacts and TerrainContactPlan::plan do): the world's terrain pairs ask both.
+bool terrainWaterContactChecked(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out);
 
 }  // namespace bw
