@@ -35,32 +35,43 @@ struct LocalShape {
   uint32_t vertexCount() const { return points ? pointCount : 8u; }
 };
 
-LocalShape placeShape(const QueryShape& s, const Vec3f& centre, const Quatf& rot) {
-  LocalShape l{centre, rot.toRotationMatrix(), Vec3f::Zero(), {}, nullptr, 0};
+// The half extents of the shape's bounds in a frame where its rotation is `rot`.
+Vec3f placedHalfBounds(const QueryShape& s, const Mat3f& rot) {
   switch (s.kind) {
     case QueryShape::Kind::Sphere:
-      l.halfBounds = Vec3f::Constant(s.radius);
-      break;
+      return Vec3f::Constant(s.radius);
     case QueryShape::Kind::Capsule:
-      l.halfBounds = (l.rot.col(2) * s.halfHeight).cwiseAbs() + Vec3f::Constant(s.radius);
-      break;
+      return (rot.col(2) * s.halfHeight).cwiseAbs() + Vec3f::Constant(s.radius);
     case QueryShape::Kind::Box:
-      l.halfBounds = l.rot.cwiseAbs() * s.halfExtents;
-      for (int k = 0; k < 8; ++k) {
-        const Vec3f sgn((k & 1) ? 1.f : -1.f, (k & 2) ? 1.f : -1.f, (k & 4) ? 1.f : -1.f);
-        l.corners[k] = l.rot * s.halfExtents.cwiseProduct(sgn) + centre;
-      }
-      break;
+      return rot.cwiseAbs() * s.halfExtents;
     case QueryShape::Kind::Hull: {
-      l.points = s.points;
-      l.pointCount = s.pointCount;
       Vec3f m = Vec3f::Zero();
-      for (uint32_t i = 0; i < s.pointCount; ++i) m = m.cwiseMax((l.rot * s.points[i]).cwiseAbs());
-      l.halfBounds = m;
-      break;
+      for (uint32_t i = 0; i < s.pointCount; ++i) m = m.cwiseMax((rot * s.points[i]).cwiseAbs());
+      return m;
     }
   }
+  return Vec3f::Zero();
+}
+
+LocalShape placeShape(const QueryShape& s, const Vec3f& centre, const Quatf& rot) {
+  LocalShape l{centre, rot.toRotationMatrix(), Vec3f::Zero(), {}, nullptr, 0};
+  l.halfBounds = placedHalfBounds(s, l.rot);
+  if (s.kind == QueryShape::Kind::Box) {
+    for (int k = 0; k < 8; ++k) {
+      const Vec3f sgn((k & 1) ? 1.f : -1.f, (k & 2) ? 1.f : -1.f, (k & 4) ? 1.f : -1.f);
+      l.corners[k] = l.rot * s.halfExtents.cwiseProduct(sgn) + centre;
+    }
+  } else if (s.kind == QueryShape::Kind::Hull) {
+    l.points = s.points;
+    l.pointCount = s.pointCount;
+  }
   return l;
+}
+
+/// The bounds placeShape gives (centre -+ halfBounds), without the corners a triangle test needs:
+/// what the broadphase steps and the water sum read.
+Aabb placedBounds(const QueryShape& s, const Vec3f& centre, const Quatf& rot) {
+  return Aabb::fromCenterHalf(centre, placedHalfBounds(s, rot.toRotationMatrix()));
 }
 
 /// Box/hull vs one triangle. With the shape's centre in front of the face: its vertices that
@@ -189,8 +200,7 @@ namespace {
 template <class F>
 void forEachQueriedChunk(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, float spec, F&& f) {
   const RigidTransform& place = terrain.placement();
-  const LocalShape inTerrain = placeShape(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation));
-  const Aabb terrainBox = Aabb::fromCenterHalf(inTerrain.centre, inTerrain.halfBounds).expanded(spec);
+  const Aabb terrainBox = placedBounds(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation)).expanded(spec);
   VoxelRange range;
   if (!terrain.broadphase().voxelRangeOf(terrainBox, terrain.voxelSize(), range)) return;
   bool going = true;
@@ -252,8 +262,7 @@ bool planWith(TerrainContactPlan& p, const Terrain& terrain, const QueryShape& s
     if (!found) return complete = false;
     if (found->mesh.triangleCount() == 0) return true;
     const RigidTransform xf = terrain.chunkTransform(chunk);
-    const LocalShape ls = placeShape(shape, xf.pointToLocal(pose.translation), xf.rotationToLocal(pose.rotation));
-    const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds).expanded(spec);
+    const Aabb box = placedBounds(shape, xf.pointToLocal(pose.translation), xf.rotationToLocal(pose.rotation)).expanded(spec);
     const uint32_t first = uint32_t(p.triangles_.size());
     found->tree.queryAabb(found->mesh.view(), box, [&](uint32_t t) { p.triangles_.push_back({found, chunk, t}); });
     chunkDone(first, uint32_t(p.triangles_.size()));
@@ -419,8 +428,7 @@ bool terrainWaterContact(const Terrain& terrain, const QueryShape& shape, const 
 bool terrainWaterContactChecked(const Terrain& terrain, const QueryShape& shape, const RigidTransform& pose, WaterContact& out) {
   out = {};
   const RigidTransform& place = terrain.placement();
-  const LocalShape ls = placeShape(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation));
-  const Aabb box = Aabb::fromCenterHalf(ls.centre, ls.halfBounds);
+  const Aabb box = placedBounds(shape, place.pointToLocal(pose.translation), place.rotationToLocal(pose.rotation));
   const float vs = terrain.voxelSize();
   const Int3 size = terrain.voxels().size();
   int lo[3], hi[3];
