@@ -231,6 +231,14 @@ struct TerrainContactPlan::BulletShapes {
   Hull hull;
 };
 
+struct TerrainContactPlan::PlacedChunk {
+  const ChunkCollision* chunk;
+  Int3 coords;
+  RigidTransform xf;  // the chunk's frame in the world
+  LocalShape shape;   // the query's shape in that frame
+  btTransform btXf;   // the same placement as Bullet's GJK takes it
+};
+
 TerrainContactPlan::TerrainContactPlan() : bullet_(std::make_unique<BulletShapes>()) {}
 TerrainContactPlan::~TerrainContactPlan() = default;
 TerrainContactPlan::TerrainContactPlan(TerrainContactPlan&&) noexcept = default;
@@ -250,6 +258,7 @@ bool planWith(TerrainContactPlan& p, const Terrain& terrain, const QueryShape& s
   p.pose_ = pose;
   p.spec_ = spec;
   p.triangles_.clear();
+  p.placed_.clear();
   if (shape.kind == QueryShape::Kind::Box) {
     p.bullet_->box.emplace(toBt(shape.halfExtents.cwiseMax(Vec3f::Constant(1e-6f))));
     p.bullet_->box->setMargin(0.f);
@@ -262,13 +271,24 @@ bool planWith(TerrainContactPlan& p, const Terrain& terrain, const QueryShape& s
     if (!found) return complete = false;
     if (found->mesh.triangleCount() == 0) return true;
     const RigidTransform xf = terrain.chunkTransform(chunk);
-    const Aabb box = placedBounds(shape, xf.pointToLocal(pose.translation), xf.rotationToLocal(pose.rotation)).expanded(spec);
+    const Vec3f localCentre = xf.pointToLocal(pose.translation);
+    const Quatf localRot = xf.rotationToLocal(pose.rotation);
+    const Aabb box = placedBounds(shape, localCentre, localRot).expanded(spec);
     const uint32_t first = uint32_t(p.triangles_.size());
-    found->tree.queryAabb(found->mesh.view(), box, [&](uint32_t t) { p.triangles_.push_back({found, chunk, t}); });
+    const uint32_t placed = uint32_t(p.placed_.size());
+    found->tree.queryAabb(found->mesh.view(), box, [&](uint32_t t) { p.triangles_.push_back({placed, t}); });
+    if (p.triangles_.size() > first) {
+      const LocalShape ls = placeShape(shape, localCentre, localRot);
+      const btTransform btXf(btQuaternion(localRot.x(), localRot.y(), localRot.z(), localRot.w()), toBt(ls.centre));
+      p.placed_.push_back({found, chunk, xf, ls, btXf});
+    }
     chunkDone(first, uint32_t(p.triangles_.size()));
     return true;
   });
-  if (!complete) p.triangles_.clear();
+  if (!complete) {
+    p.triangles_.clear();
+    p.placed_.clear();
+  }
   return complete;
 }
 
@@ -288,23 +308,12 @@ void TerrainContactPlan::contactsOfTriangles(uint32_t begin, uint32_t end, std::
   const btConvexShape* convex = nullptr;
   if (shape.kind == QueryShape::Kind::Box) convex = &*bullet_->box;
   if (shape.kind == QueryShape::Kind::Hull) convex = &bullet_->hull;
-  // The shape in the frame of the chunk at hand, placed again when the chunk changes.
-  const ChunkCollision* placedIn = nullptr;
-  Int3 placedAt{};
-  RigidTransform xf;
-  LocalShape ls{};
-  btTransform btXf;
   for (uint32_t i = begin; i < end; ++i) {
     const Triangle& tr = triangles_[i];
-    if (tr.chunk != placedIn || tr.coords != placedAt) {
-      placedIn = tr.chunk;
-      placedAt = tr.coords;
-      xf = terrain_->chunkTransform(tr.coords);
-      const Quatf localRot = xf.rotationToLocal(pose_.rotation);
-      ls = placeShape(shape, xf.pointToLocal(pose_.translation), localRot);
-      btXf = btTransform(btQuaternion(localRot.x(), localRot.y(), localRot.z(), localRot.w()), toBt(ls.centre));
-    }
-    const TriangleMeshView mesh = tr.chunk->mesh.view();
+    const PlacedChunk& pc = placed_[tr.placed];
+    const RigidTransform& xf = pc.xf;
+    const LocalShape& ls = pc.shape;
+    const TriangleMeshView mesh = pc.chunk->mesh.view();
     const uint32_t t = tr.triangle;
     Vec3f a, b, c;
     mesh.corners(t, a, b, c);
@@ -327,12 +336,12 @@ void TerrainContactPlan::contactsOfTriangles(uint32_t begin, uint32_t end, std::
       }
       case QueryShape::Kind::Box:
       case QueryShape::Kind::Hull:
-        k = convexTriangle(*convex, btXf, ls, a, b, c, n, spec_, lc, 8);
+        k = convexTriangle(*convex, pc.btXf, ls, a, b, c, n, spec_, lc, 8);
         break;
     }
     for (int j = 0; j < k; ++j) {
-      out.push_back({xf.pointToWorld(lc[j].point), xf.directionToWorld(lc[j].normal), lc[j].depth, featureOf(tr.coords, t),
-                     tr.chunk->mesh.materials[t]});
+      out.push_back({xf.pointToWorld(lc[j].point), xf.directionToWorld(lc[j].normal), lc[j].depth, featureOf(pc.coords, t),
+                     pc.chunk->mesh.materials[t]});
       faceNormals.push_back(xf.directionToWorld(n));
     }
   }

@@ -77,14 +77,15 @@ class TerrainContactPlan {
   /// normal of each one's triangle to `faceNormals`.
   void contactsOfTriangles(uint32_t begin, uint32_t end, std::vector<Contact>& out, std::vector<Vec3f>& faceNormals) const;
 
-  struct Triangle {
-    const ChunkCollision* chunk;
-    Int3 coords;
-    uint32_t triangle;
-  };
-
  private:
   struct BulletShapes;
+  /// A chunk the query meets, with the shape placed in its frame once for all its candidate
+  /// triangles: pieces of a single triangle then cost no more placing than whole queries.
+  struct PlacedChunk;
+  struct Triangle {
+    uint32_t placed;    // its chunk in placed_
+    uint32_t triangle;  // in that chunk's mesh
+  };
   template <class Lookup, class ChunkDone>
   friend bool planWith(TerrainContactPlan&, const Terrain&, const QueryShape&, const RigidTransform&, float, Lookup&&,
                        ChunkDone&&);
@@ -94,6 +95,7 @@ class TerrainContactPlan {
   RigidTransform pose_;
   float spec_ = 0.f;
   std::vector<Triangle> triangles_;
+  std::vector<PlacedChunk> placed_;
   std::unique_ptr<BulletShapes> bullet_;  // the box or hull as Bullet's GJK takes it, reused
 };
 
