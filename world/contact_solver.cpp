@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "world/contact_update.h"
 #include "world/world_tuning.h"
 
 namespace bw {
@@ -17,15 +18,6 @@ float rollingRadius(const BodyShape& shape) {
   return k == QueryShape::Kind::Sphere || k == QueryShape::Kind::Capsule ? shape.primitive.radius : 0.f;
 }
 
-// Coulomb's cone: the friction impulse (t1, t2) is scaled back to length `limit` when longer.
-// note: clamping each tangent on its own (a pyramid) pushes sideways to the sliding direction:
-// a capsule landing on its end came away rolling about its own axis at up to 4 rad/s.
-void clampToFrictionCone(float t1, float t2, float limit, float& out1, float& out2) {
-  const float length2 = t1 * t1 + t2 * t2;
-  const float scale = length2 > limit * limit ? limit / std::sqrt(length2) : 1.f;
-  out1 = t1 * scale;
-  out2 = t2 * scale;
-}
 }  // namespace
 
 // One solver contact from contact c of a pair whose solver bodies are a and b (the normal points
@@ -186,66 +178,13 @@ void ContactSolver::storeBodies(BodyStore& bodies, JobSystem& jobs, Profiler& pr
   });
 }
 
-namespace {
 
-// A contact's two bodies in locals while the contact is solved: the compiler then keeps them in
-// registers, where stores through the bodies' records could alias the contact's floats and made
-// it load them again after every store. The same operations in the same order as on the
-// records, so the same results. Impulses change dynamic bodies only (static and kinematic
-// bodies are read, never written); store() writes back only those.
-struct ContactBodies {
-  SolverBody& bodyA;
-  SolverBody& bodyB;
-  Vec3f vA = bodyA.v, wA = bodyA.w, vB = bodyB.v, wB = bodyB.w;
+void ContactSolver::warmStart(const SolverContact& s, SolverBody& a, SolverBody& b) { warmStartContact(s, a, b); }
 
-  // The velocity of a's point relative to b's.
-  Vec3f relative(const SolverContact& s) const { return Vec3f(vA + wA.cross(s.rA) - vB - wB.cross(s.rB)); }
-  // Impulse `lambda` along direction d (0 normal, 1 and 2 tangents): a receives +, b -.
-  void apply(const SolverContact& s, int d, const Vec3f& dir, float lambda) {
-    if (bodyA.dynamic) {
-      vA += dir * (lambda * bodyA.invMass);
-      wA += s.angA[d] * lambda;
-    }
-    if (bodyB.dynamic) {
-      vB -= dir * (lambda * bodyB.invMass);
-      wB -= s.angB[d] * lambda;
-    }
-  }
-  void store() const {
-    if (bodyA.dynamic) bodyA.v = vA, bodyA.w = wA;
-    if (bodyB.dynamic) bodyB.v = vB, bodyB.w = wB;
-  }
-};
-
-}  // namespace
-
-void ContactSolver::warmStart(const SolverContact& s, SolverBody& a, SolverBody& b) {
-  ContactBodies ab{a, b};
-  ab.apply(s, 0, s.normal, s.lambdaN);
-  ab.apply(s, 1, s.t1, s.lambdaT1);
-  ab.apply(s, 2, s.t2, s.lambdaT2);
-  ab.store();
-}
-
-// One Gauss-Seidel update of one contact: normal impulse clamped at zero, then friction
-// clamped by the Coulomb bound.
+// One Gauss-Seidel update of one contact (world/contact_update.h), then its rolling resistance.
 void ContactSolver::solveContact(uint32_t k, bool relax, SolverBody& a, SolverBody& b) {
   SolverContact& s = contacts_[k];
-  ContactBodies ab{a, b};
-  const float oldN = s.lambdaN;
-  const float lambdaN = std::max(oldN + s.massN * ((relax ? s.relaxBias : s.bias) - ab.relative(s).dot(s.normal)), 0.f);
-  ab.apply(s, 0, s.normal, lambdaN - oldN);
-  const float limit = s.friction * lambdaN;
-  const Vec3f v = ab.relative(s);
-  const float o1 = s.lambdaT1, o2 = s.lambdaT2;
-  float lambdaT1, lambdaT2;
-  clampToFrictionCone(o1 - s.massT1 * v.dot(s.t1), o2 - s.massT2 * v.dot(s.t2), limit, lambdaT1, lambdaT2);
-  ab.apply(s, 1, s.t1, lambdaT1 - o1);
-  ab.apply(s, 2, s.t2, lambdaT2 - o2);
-  ab.store();
-  s.lambdaN = lambdaN;
-  s.lambdaT1 = lambdaT1;
-  s.lambdaT2 = lambdaT2;
+  updateContact(s, relax, a, b);
   if (s.rolling > 0.f) resistRolling(s, extras_[k], a, b);
 }
 
