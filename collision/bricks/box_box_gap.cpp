@@ -97,7 +97,7 @@ void faceCorners(const Vec3d& half, int k, bool positive, Vec3d (&corner)[4]) {
 }  // namespace
 
 std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA,
-                                      const Vec3f& halfB, const Mat3f& rotationB, const Vec3f& centreB) {
+                                      const Vec3f& halfB, const Mat3f& rotationB, const Vec3f& centreB, float atLeast) {
   // In double, in b's frame (a's centre c and axes r there), rotations made orthonormal: the
   // bounds below then meet to within double rounding. (In float, a candidate's direction, a
   // difference of nearby points over a small gap, was off by up to 0.1, and the rotations'
@@ -107,6 +107,10 @@ std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA
   const Vec3d c = rb.transpose() * (centreA.cast<double>() - centreB.cast<double>());
   const Vec3d a = halfA.cast<double>(), b = halfB.cast<double>();
   const double scale = c.norm() + a.sum() + b.sum();
+  // The largest face-axis separation bounds the gap from below (to double rounding of the
+  // inputs, well inside the slack): beyond atLeast, the caller needs no more.
+  const Axis face = largestFaceSeparation(c, r, a, b);
+  if (face.separation >= double(atLeast) * (1.0 + 1e-6) + 1e-9 * scale) return BoxGap{float(face.separation), Vec3f::Zero(), Vec3f::Zero()};
   // Candidates, each a point of a and a point of b (their distance bounds the gap from above),
   // first a's vertices against b and b's against a (each vertex's nearest point of the other box).
   PointPair best;
@@ -147,7 +151,6 @@ std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA
     if (!(gap > 1e-9 * scale)) return std::nullopt;  // touching, to double rounding: no direction
     return BoxGap{float(gap), (centreB.cast<double>() + rb * best.onB).cast<float>(), (rb * direction()).cast<float>()};
   };
-  const Axis face = largestFaceSeparation(c, r, a, b);
   if (met(face) || metAlongCandidate()) return answer();
   // Nearest points inside two edges, along the axis of largest separation (the nearest
   // direction, when they are), the other kind of axis tried next for near ties.

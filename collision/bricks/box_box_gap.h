@@ -16,6 +16,7 @@
 /// read as orthonormal rotations. nullopt for touching or overlapping boxes, and for a near tie
 /// of two axes that picked other edges (none in the 6,500 seeded separated pairs of its test): the caller
 /// measures those another way.
+#include <cmath>
 #include <optional>
 
 #include "collision/core/math_types.h"
@@ -29,7 +30,12 @@ struct BoxGap {
 };
 
 /// Boxes given by half extents, rotation (columns: the box's axes) and centre, in one frame.
+/// With `atLeast`: boxes that their separation along a face axis (a lower bound on the gap)
+/// already shows to be at least `atLeast` apart are not measured; the result then holds only that
+/// bound as `gap` (>= atLeast; onB and normal unset). A speculative-contact caller passes its
+/// margin: most box pairs its broadphase hands it are that far apart.
 std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA,
-                                      const Vec3f& halfB, const Mat3f& rotationB, const Vec3f& centreB);
+                                      const Vec3f& halfB, const Mat3f& rotationB, const Vec3f& centreB,
+                                      float atLeast = INFINITY);
 
 }  // namespace bw

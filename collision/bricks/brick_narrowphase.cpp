@@ -391,7 +391,8 @@ int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB,
     // come in closed form (collision/bricks/box_box_gap.h); GJK measures what that declines
     // (touching to double rounding, or a near tie of two axes), on zero-margin shapes.
     if (const std::optional<BoxGap> g =
-            separatedBoxGap(halfA, fromBt(trA.getBasis()), fromBt(trA.getOrigin()), halfB, fromBt(trB.getBasis()), fromBt(trB.getOrigin()))) {
+            separatedBoxGap(halfA, fromBt(trA.getBasis()), fromBt(trA.getOrigin()), halfB, fromBt(trB.getBasis()), fromBt(trB.getOrigin()),
+                            speculativeMargin)) {
       if (g->gap >= speculativeMargin) return 0;
       out[0] = {g->onB, g->normal, -g->gap, feature, material};
       n = 1;

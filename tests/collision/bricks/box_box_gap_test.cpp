@@ -265,5 +265,41 @@ TEST(BoxBoxGap, OverlappingOrTouchingBoxesDecline) {
   EXPECT_FALSE(separatedBoxGap(b.half, b.rotation, b.centre, b.half, b.rotation, b.centre).has_value());
 }
 
+// A speculative caller passes its margin as atLeast: a pair the face axes show to be that far
+// apart gets only that bound, which must be a true lower bound (never above the exact gap) and at
+// least atLeast; every other pair gets exactly the full answer, bit for bit.
+TEST(BoxBoxGap, AtLeastStopsOnlyPairsThatFarApartAndKeepsTheRestExact) {
+  SeededRandom r(3801);
+  int bounded = 0, measured = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const Box b = randomBox(r, k % 3 == 0 ? 1e4f : 10.f);
+    Box a = randomBox(r, 0.f);
+    const Vec3f dir = test::drawVec3([&](int) { return r.normal(); }).normalized();
+    const float size = std::max(a.half.maxCoeff(), b.half.maxCoeff());
+    a.centre = placeApart(a, b, dir, float(r.logUniform(1e-4, 1.0)) * size);
+    if (!separated(a, b)) continue;
+    const Nearest exact = exactNearest(a, b);
+    const float atLeast = float(exact.distance * r.logUniform(0.1, 10.0));
+    const std::optional<BoxGap> full = separatedBoxGap(a.half, a.rotation, a.centre, b.half, b.rotation, b.centre);
+    const std::optional<BoxGap> g = separatedBoxGap(a.half, a.rotation, a.centre, b.half, b.rotation, b.centre, atLeast);
+    ASSERT_TRUE(g.has_value() || !full.has_value()) << "case " << k;
+    if (!g) continue;
+    if (g->gap >= atLeast && g->normal == Vec3f::Zero()) {  // stopped at the bound
+      ++bounded;
+      EXPECT_LE(double(g->gap), exact.distance * (1 + 1e-6) + 1e-6) << "case " << k << ": not a lower bound";
+      if (full) EXPECT_GE(full->gap, atLeast) << "case " << k << ": the full answer was within atLeast";
+    } else {
+      ++measured;
+      ASSERT_TRUE(full.has_value()) << "case " << k;
+      EXPECT_EQ(g->gap, full->gap) << "case " << k;
+      EXPECT_EQ(g->onB, full->onB) << "case " << k;
+      EXPECT_EQ(g->normal, full->normal) << "case " << k;
+    }
+  }
+  // Both kinds occur: the bound (a face axis near the nearest direction) and the full measure.
+  EXPECT_GT(bounded, 300);
+  EXPECT_GT(measured, 300);
+}
+
 }  // namespace
 }  // namespace bw
