@@ -96,21 +96,47 @@ void faceCorners(const Vec3d& half, int k, bool positive, Vec3d (&corner)[4]) {
 
 }  // namespace
 
-std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA,
-                                      const Vec3f& halfB, const Mat3f& rotationB, const Vec3f& centreB, float atLeast) {
+bool boxesFartherApartThan(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB,
+                           const Mat3f& rotationB, const Vec3f& centreB, float distance) {
+  const Vec3f d = centreA - centreB;  // correctly rounded: within 6e-8 of its own length
+  const Mat3f absR = (rotationB.transpose() * rotationA).cwiseAbs();  // a's axes in b's frame
+  const Vec3f c = rotationB.transpose() * d;
+  const float need = distance + 1e-4f * (d.norm() + halfA.sum() + halfB.sum());
+  float separation = -INFINITY;
+  for (int k = 0; k < 3; ++k) separation = std::max(separation, std::abs(c[k]) - halfB[k] - absR.row(k).dot(halfA));
+  for (int j = 0; j < 3; ++j) separation = std::max(separation, std::abs(rotationA.col(j).dot(d)) - halfA[j] - absR.col(j).dot(halfB));
+  return separation > need;
+}
+
+BoxPair boxPair(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB, const Mat3f& rotationB,
+                const Vec3f& centreB) {
   // In double, in b's frame (a's centre c and axes r there), rotations made orthonormal: the
   // bounds below then meet to within double rounding. (In float, a candidate's direction, a
   // difference of nearby points over a small gap, was off by up to 0.1, and the rotations'
   // rounding kept lower bounds 1e-7 of the size below the gap.)
-  const Mat3d rb = orthonormal(rotationB);
-  const Mat3d r = rb.transpose() * orthonormal(rotationA), rt = r.transpose();
-  const Vec3d c = rb.transpose() * (centreA.cast<double>() - centreB.cast<double>());
-  const Vec3d a = halfA.cast<double>(), b = halfB.cast<double>();
-  const double scale = c.norm() + a.sum() + b.sum();
-  // The largest face-axis separation bounds the gap from below (to double rounding of the
-  // inputs, well inside the slack): beyond atLeast, the caller needs no more.
-  const Axis face = largestFaceSeparation(c, r, a, b);
-  if (face.separation >= double(atLeast) * (1.0 + 1e-6) + 1e-9 * scale) return BoxGap{float(face.separation), Vec3f::Zero(), Vec3f::Zero()};
+  BoxPair p;
+  p.rb = orthonormal(rotationB);
+  p.r = p.rb.transpose() * orthonormal(rotationA);
+  p.centreB = centreB.cast<double>();
+  p.c = p.rb.transpose() * (centreA.cast<double>() - p.centreB);
+  p.a = halfA.cast<double>();
+  p.b = halfB.cast<double>();
+  p.scale = p.c.norm() + p.a.sum() + p.b.sum();
+  const Axis face = largestFaceSeparation(p.c, p.r, p.a, p.b);
+  p.faceSeparation = face.separation;
+  p.faceDirection = face.direction;
+  return p;
+}
+
+std::optional<BoxGap> separatedBoxGap(const BoxPair& pair) {
+  const Mat3d& rb = pair.rb;
+  const Mat3d& r = pair.r;
+  const Mat3d rt = r.transpose();
+  const Vec3d &c = pair.c, &a = pair.a, &b = pair.b;
+  const double scale = pair.scale;
+  Axis face;
+  face.separation = pair.faceSeparation;
+  face.direction = pair.faceDirection;
   // Candidates, each a point of a and a point of b (their distance bounds the gap from above),
   // first a's vertices against b and b's against a (each vertex's nearest point of the other box).
   PointPair best;
@@ -149,7 +175,7 @@ std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA
   auto answer = [&]() -> std::optional<BoxGap> {
     const double gap = std::sqrt(best.distance2);
     if (!(gap > 1e-9 * scale)) return std::nullopt;  // touching, to double rounding: no direction
-    return BoxGap{float(gap), (centreB.cast<double>() + rb * best.onB).cast<float>(), (rb * direction()).cast<float>()};
+    return BoxGap{float(gap), (pair.centreB + rb * best.onB).cast<float>(), (rb * direction()).cast<float>()};
   };
   if (met(face) || metAlongCandidate()) return answer();
   // Nearest points inside two edges, along the axis of largest separation (the nearest

@@ -16,7 +16,6 @@
 /// read as orthonormal rotations. nullopt for touching or overlapping boxes, and for a near tie
 /// of two axes that picked other edges (none in the 6,500 seeded separated pairs of its test): the caller
 /// measures those another way.
-#include <cmath>
 #include <optional>
 
 #include "collision/core/math_types.h"
@@ -29,13 +28,38 @@ struct BoxGap {
   Vec3f normal;   ///< unit, from b towards a: onB + normal * gap is the nearest point of a
 };
 
+/// Two boxes as separatedBoxGap measures them: in b's frame, in double, rotations made
+/// orthonormal, with the largest separation along a face axis. That separation is a lower bound
+/// on their gap (to double rounding of the inputs): a speculative-contact caller that finds it
+/// over its margin needs nothing more, and most box pairs a broadphase hands over are that far.
+struct BoxPair {
+  Mat3d rb;                  ///< b's rotation
+  Mat3d r;                   ///< a's axes in b's frame
+  Vec3d c;                   ///< a's centre in b's frame
+  Vec3d a, b;                ///< half extents
+  Vec3d centreB;
+  double scale;              ///< |c| + the half extents' sums: what rounding is relative to
+  double faceSeparation;     ///< the largest separation along one of the 6 face axes (<= the gap)
+  Vec3d faceDirection;       ///< that axis, from b towards a
+};
+
 /// Boxes given by half extents, rotation (columns: the box's axes) and centre, in one frame.
-/// With `atLeast`: boxes that their separation along a face axis (a lower bound on the gap)
-/// already shows to be at least `atLeast` apart are not measured; the result then holds only that
-/// bound as `gap` (>= atLeast; onB and normal unset). A speculative-contact caller passes its
-/// margin: most box pairs its broadphase hands it are that far apart.
-std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA,
-                                      const Vec3f& halfB, const Mat3f& rotationB, const Vec3f& centreB,
-                                      float atLeast = INFINITY);
+/// True when the 6 face axes, in float, show the boxes farther apart than `distance` by more than
+/// 1e-4 of the pair's size (|centre difference| + the half extents' sums): far more than float
+/// rounding (relative 1e-7 a step) and float rotations' distance from orthonormal (~1e-7) can
+/// move a separation, so the boxes' BoxPair::faceSeparation (exact to double rounding of the same
+/// inputs) is then over `distance` too. A cheap first test, before a BoxPair is made.
+bool boxesFartherApartThan(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB,
+                           const Mat3f& rotationB, const Vec3f& centreB, float distance);
+
+BoxPair boxPair(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB, const Mat3f& rotationB,
+                const Vec3f& centreB);
+
+std::optional<BoxGap> separatedBoxGap(const BoxPair& pair);
+
+inline std::optional<BoxGap> separatedBoxGap(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB,
+                                             const Mat3f& rotationB, const Vec3f& centreB) {
+  return separatedBoxGap(boxPair(halfA, rotationA, centreA, halfB, rotationB, centreB));
+}
 
 }  // namespace bw

@@ -374,6 +374,18 @@ int addSpeculativeCorners(const Vec3f& halfA, const btTransform& trA, const Vec3
 // the corners of a facing a face of b within the margin are added (addSpeculativeCorners).
 int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB, const btTransform& trB, uint32_t feature,
                  uint32_t material, float speculativeMargin, LocalContact* out) {
+  std::optional<BoxPair> pair;
+  if (speculativeMargin > 0.f) {
+    // Beyond the margin along a face axis, by more than float rounding of the detector's own
+    // tests: no contact of any kind, and Bullet's detector (which would find them apart) and the
+    // gap measure are not asked. Most box pairs a broadphase hands over are that far apart.
+    // (A float test first, for the many far apart; then the exact one in double.)
+    const Mat3f rotationA = fromBt(trA.getBasis()), rotationB = fromBt(trB.getBasis());
+    const Vec3f centreA = fromBt(trA.getOrigin()), centreB = fromBt(trB.getOrigin());
+    if (boxesFartherApartThan(halfA, rotationA, centreA, halfB, rotationB, centreB, speculativeMargin)) return 0;
+    pair = boxPair(halfA, rotationA, centreA, halfB, rotationB, centreB);
+    if (pair->faceSeparation >= double(speculativeMargin) + 1e-5 * pair->scale) return 0;
+  }
   btBoxShape a(bt(halfA)), b(bt(halfB));
   btBoxBoxDetector det(&a, &b);
   btDiscreteCollisionDetectorInterface::ClosestPointInput in;
@@ -390,9 +402,7 @@ int collideBoxes(const Vec3f& halfA, const btTransform& trA, const Vec3f& halfB,
     // note: the detector reports touching boxes only. A separated pair's gap and nearest points
     // come in closed form (collision/bricks/box_box_gap.h); GJK measures what that declines
     // (touching to double rounding, or a near tie of two axes), on zero-margin shapes.
-    if (const std::optional<BoxGap> g =
-            separatedBoxGap(halfA, fromBt(trA.getBasis()), fromBt(trA.getOrigin()), halfB, fromBt(trB.getBasis()), fromBt(trB.getOrigin()),
-                            speculativeMargin)) {
+    if (const std::optional<BoxGap> g = separatedBoxGap(*pair)) {
       if (g->gap >= speculativeMargin) return 0;
       out[0] = {g->onB, g->normal, -g->gap, feature, material};
       n = 1;
