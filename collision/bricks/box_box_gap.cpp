@@ -99,13 +99,20 @@ void faceCorners(const Vec3d& half, int k, bool positive, Vec3d (&corner)[4]) {
 bool boxesFartherApartThan(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB,
                            const Mat3f& rotationB, const Vec3f& centreB, float distance) {
   const Vec3f d = centreA - centreB;  // correctly rounded: within 6e-8 of its own length
-  const Mat3f absR = (rotationB.transpose() * rotationA).cwiseAbs();  // a's axes in b's frame
-  const Vec3f c = rotationB.transpose() * d;
-  const float need = distance + 1e-4f * (d.norm() + halfA.sum() + halfB.sum());
-  float separation = -INFINITY;
-  for (int k = 0; k < 3; ++k) separation = std::max(separation, std::abs(c[k]) - halfB[k] - absR.row(k).dot(halfA));
-  for (int j = 0; j < 3; ++j) separation = std::max(separation, std::abs(rotationA.col(j).dot(d)) - halfA[j] - absR.col(j).dot(halfB));
-  return separation > need;
+  // The slack taken from d's 1-norm (>= its length: a larger slack, no square root).
+  const float need = distance + 1e-4f * (std::abs(d.x()) + std::abs(d.y()) + std::abs(d.z()) + halfA.sum() + halfB.sum());
+  float absR[3][3];  // |b's axis k . a's axis j|: a's axes in b's frame, a row per b axis tried
+  // Any one axis over `need` settles it: b's face axes first, then a's.
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 3; ++j) absR[k][j] = std::abs(rotationB.col(k).dot(rotationA.col(j)));
+    const float reach = halfB[k] + absR[k][0] * halfA[0] + absR[k][1] * halfA[1] + absR[k][2] * halfA[2];
+    if (std::abs(rotationB.col(k).dot(d)) - reach > need) return true;
+  }
+  for (int j = 0; j < 3; ++j) {
+    const float reach = halfA[j] + absR[0][j] * halfB[0] + absR[1][j] * halfB[1] + absR[2][j] * halfB[2];
+    if (std::abs(rotationA.col(j).dot(d)) - reach > need) return true;
+  }
+  return false;
 }
 
 BoxPair boxPair(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB, const Mat3f& rotationB,
