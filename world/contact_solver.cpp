@@ -17,7 +17,6 @@ float rollingRadius(const BodyShape& shape) {
   const QueryShape::Kind k = shape.primitive.kind;
   return k == QueryShape::Kind::Sphere || k == QueryShape::Kind::Capsule ? shape.primitive.radius : 0.f;
 }
-
 }  // namespace
 
 // One solver contact from contact c of a pair whose solver bodies are a and b (the normal points
@@ -177,7 +176,6 @@ void ContactSolver::storeBodies(BodyStore& bodies, JobSystem& jobs, Profiler& pr
     }
   });
 }
-
 
 void ContactSolver::warmStart(const SolverContact& s, SolverBody& a, SolverBody& b) { warmStartContact(s, a, b); }
 

@@ -92,8 +92,9 @@ inline void updateContactScalar(SolverContact& s, bool relax, SolverBody& a, Sol
 namespace sse_contact {
 
 // A Vec3f in lanes 0-2 of a register. The load reads the 4 bytes after the vector too (every
-// Vec3f the solver loads has a field of its record after it); lane 3 is then zeroed, so a
-// body's `dynamic` word (a denormal as a float) never enters the arithmetic, and ignored.
+// Vec3f the solver loads has a field of its record after it); lane 3 is zeroed, so a body's
+// `dynamic` word (a denormal read as a float, slow to multiply) never enters the arithmetic.
+// Lane 3 of every result is ignored.
 inline __m128 load3(const Vec3f& v) {
   const __m128 lanes012 = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
   return _mm_and_ps(_mm_loadu_ps(v.data()), lanes012);

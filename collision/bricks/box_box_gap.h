@@ -43,12 +43,15 @@ struct BoxPair {
   Vec3d faceDirection;       ///< that axis, from b towards a
 };
 
-/// Boxes given by half extents, rotation (columns: the box's axes) and centre, in one frame.
-/// True when the 6 face axes, in float, show the boxes farther apart than `distance` by more than
-/// 1e-4 of the pair's size (the centre difference's 1-norm + the half extents' sums): far more than float
-/// rounding (relative 1e-7 a step) and float rotations' distance from orthonormal (~1e-7) can
-/// move a separation, so the boxes' BoxPair::faceSeparation (exact to double rounding of the same
-/// inputs) is then over `distance` too. A cheap first test, before a BoxPair is made.
+// Boxes below are given by half extents, rotation (columns: the box's axes) and centre, in one
+// frame.
+
+/// True when the 6 face axes, in float, show the boxes farther apart than `distance` by more
+/// than 1e-4 of the pair's size (the centre difference's 1-norm + the half extents' sums): far
+/// more than float rounding (relative 1e-7 a step) and float rotations' distance from
+/// orthonormal (~1e-7) can move a separation, so the boxes' BoxPair::faceSeparation (exact to
+/// double rounding of the same inputs) is then over `distance` too. A cheap first test, before
+/// a BoxPair is made.
 bool boxesFartherApartThan(const Vec3f& halfA, const Mat3f& rotationA, const Vec3f& centreA, const Vec3f& halfB,
                            const Mat3f& rotationB, const Vec3f& centreB, float distance);
 
