@@ -141,10 +141,11 @@ inline constexpr uint32_t kPairGrain = 4;
 inline constexpr uint32_t kMinTerrainGrain = 1;
 /// Candidate triangles per piece of one terrain query (TerrainPairWork): a box or hull tests each
 /// by GJK (and EPA when it touches, a few microseconds), a sphere or capsule in closed form.
-/// One triangle a piece for boxes and hulls (jobs then take two or three on monument, where
-/// pieces of four made single 13 us jobs of a few EPA triangles: 9 -> 5 ms of its 16-thread
-/// bound, profiles/RESULTS.md session 38); a plan places the shape once per chunk, so a finer
-/// piece costs only its output's join (quarry -0.2%, monument +0.1% step instructions).
+/// One triangle a piece for boxes and hulls: on monument, pieces of four put a few EPA triangles
+/// in one job (the stage's longest job 14.4 us on average, 10.5 at one a piece; its share of the
+/// 16-thread bound 7.1 -> 5.0 ms, profiles/RESULTS.md session 38). A plan places the shape once
+/// per chunk, so a finer piece costs only its output's join (quarry -0.2%, monument +0.1% step
+/// instructions).
 inline constexpr uint32_t kConvexTrianglesPerPiece = 1;
 inline constexpr uint32_t kRoundTrianglesPerPiece = 32;
 /// Rays per job in the scene's ray load.

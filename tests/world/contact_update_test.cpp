@@ -69,9 +69,7 @@ TEST(ContactUpdate, SseGivesTheScalarReferenceBitForBit) {
     const uint32_t bodies = 2 + uint32_t(rng() % 40);
     Island ref = randomIsland(rng, bodies, 1 + uint32_t(rng() % 120), scale);
     Island simd = ref;
-    for (const SolverContact& s : ref.contacts) {
-      warmStartScalar(s, ref.bodies[s.a], ref.bodies[s.b]);
-    }
+    for (const SolverContact& s : ref.contacts) warmStartScalar(s, ref.bodies[s.a], ref.bodies[s.b]);
     for (const SolverContact& s : simd.contacts) warmStartContact(s, simd.bodies[s.a], simd.bodies[s.b]);
     for (int it = 0; it < 10; ++it) {
       const bool relax = it >= 8;

@@ -13,6 +13,7 @@
 #include <limits>
 #include <gtest/gtest.h>
 #include <optional>
+#include <utility>
 
 #include "collision/bricks/box_box_gap.h"
 #include "collision/core/seeded_random.h"
@@ -183,15 +184,24 @@ Box randomBox(SeededRandom& r, float far) {
   return b;
 }
 
+// Case k of a random pair: b near the origin or (every third case) 1e4 from it, a beside it
+// along a random direction, `drawExtra()` of the larger box's size beyond the first touch
+// (negative: inside). Draws in this order, so a seed gives the same cases.
+template <class DrawExtra>
+std::pair<Box, Box> randomPair(SeededRandom& r, int k, DrawExtra&& drawExtra) {
+  const Box b = randomBox(r, k % 3 == 0 ? 1e4f : 10.f);
+  Box a = randomBox(r, 0.f);
+  const Vec3f dir = test::drawVec3([&](int) { return r.normal(); }).normalized();
+  const float size = std::max(a.half.maxCoeff(), b.half.maxCoeff());
+  a.centre = placeApart(a, b, dir, float(drawExtra()) * size);
+  return {a, b};
+}
+
 TEST(BoxBoxGap, RandomPosesAnswerExactlyOrDecline) {
   SeededRandom r(4101);
   Tally t;
   for (int k = 0; k < 3000; ++k) {
-    const Box b = randomBox(r, k % 3 == 0 ? 1e4f : 10.f);
-    Box a = randomBox(r, 0.f);
-    const Vec3f dir = test::drawVec3([&](int) { return r.normal(); }).normalized();
-    const float size = std::max(a.half.maxCoeff(), b.half.maxCoeff());
-    a.centre = placeApart(a, b, dir, float(r.logUniform(1e-4, 1.0)) * size);
+    const auto [a, b] = randomPair(r, k, [&] { return r.logUniform(1e-4, 1.0); });
     check(a, b, t, k);
   }
   t.report("random poses");
@@ -272,11 +282,7 @@ TEST(BoxBoxGap, FaceSeparationIsALowerBoundOnTheGap) {
   SeededRandom r(3801);
   int close = 0, cases = 0;
   for (int k = 0; k < 3000; ++k) {
-    const Box b = randomBox(r, k % 3 == 0 ? 1e4f : 10.f);
-    Box a = randomBox(r, 0.f);
-    const Vec3f dir = test::drawVec3([&](int) { return r.normal(); }).normalized();
-    const float size = std::max(a.half.maxCoeff(), b.half.maxCoeff());
-    a.centre = placeApart(a, b, dir, float(r.uniform(-0.5, 1.0)) * size);
+    const auto [a, b] = randomPair(r, k, [&] { return r.uniform(-0.5, 1.0); });
     const BoxPair pair = boxPair(a.half, a.rotation, a.centre, b.half, b.rotation, b.centre);
     if (!separated(a, b)) {
       EXPECT_LE(pair.faceSeparation, 1e-9 * pair.scale) << "case " << k << ": overlapping boxes";
@@ -298,11 +304,7 @@ TEST(BoxBoxGap, TheFloatFirstTestRejectsOnlyWhatTheExactOneDoes) {
   SeededRandom r(3802);
   int rejected = 0, kept = 0;
   for (int k = 0; k < 6000; ++k) {
-    const Box b = randomBox(r, k % 3 == 0 ? 1e4f : 10.f);
-    Box a = randomBox(r, 0.f);
-    const Vec3f dir = test::drawVec3([&](int) { return r.normal(); }).normalized();
-    const float size = std::max(a.half.maxCoeff(), b.half.maxCoeff());
-    a.centre = placeApart(a, b, dir, float(r.uniform(-0.2, 0.5)) * size);
+    const auto [a, b] = randomPair(r, k, [&] { return r.uniform(-0.2, 0.5); });
     const BoxPair pair = boxPair(a.half, a.rotation, a.centre, b.half, b.rotation, b.centre);
     // Distances around the face separation, so both answers occur near the edge.
     const float d = float(std::max(0.0, pair.faceSeparation * r.uniform(0.9, 1.1)));
