@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "world/contact_update.h"
+#include "world/island_lanes.h"
 #include "world/world_tuning.h"
 
 namespace bw {
@@ -186,19 +187,6 @@ void ContactSolver::solveContact(uint32_t k, bool relax, SolverBody& a, SolverBo
   if (s.rolling > 0.f) resistRolling(s, extras_[k], a, b);
 }
 
-// Rolling resistance: the relative spin about the two tangent axes (rolling, not spinning about
-// the normal) is opposed by an angular impulse within a cone of rolling x lambdaN, as friction
-// opposes sliding. Without it a capsule that lands spinning about its axis rolls forever and
-// never sleeps.
-void ContactSolver::resistRolling(const SolverContact& s, SolverContactExtras& x, SolverBody& a, SolverBody& b) {
-  const Vec3f w = a.w - b.w;
-  const float o1 = x.lambdaR1, o2 = x.lambdaR2;
-  clampToFrictionCone(o1 - x.massR[0] * w.dot(s.t1), o2 - x.massR[1] * w.dot(s.t2), s.rolling * s.lambdaN, x.lambdaR1, x.lambdaR2);
-  const float d1 = x.lambdaR1 - o1, d2 = x.lambdaR2 - o2;
-  if (a.dynamic) a.w += x.rollA[0] * d1 + x.rollA[1] * d2;
-  if (b.dynamic) b.w -= x.rollB[0] * d1 + x.rollB[1] * d2;
-}
-
 // Shock propagation (Guendelman et al.): after the iterations, one sweep from the bottom of the
 // pile up in which each contact treats its lower body as immovable, so a heavy body cannot push
 // a light one below it into the ground (the 1000:1 mass-ratio stack). Only the upper body's
@@ -263,6 +251,37 @@ void ContactSolver::solveIsland(std::span<const uint32_t> island, bool relax, co
     thread_local std::vector<uint32_t> list;  // note: per worker thread, reused across islands
     list.assign(island.begin(), island.end());
     shockSweep(list);
+  }
+}
+
+// A job's islands, four at a time in the lanes of IslandLanes (the same bits as one by one):
+// largest first, so that the islands sharing the lanes are of similar sizes. An island left
+// alone, or among much smaller ones, is solved on its own (a row of lanes costs about 1.5
+// contact updates: lanes pay once they are busy).
+void ContactSolver::solveIslandsInLanes(const Islands& islands, std::span<const uint32_t> which, bool relax,
+                                        const SceneSettings& settings) {
+  thread_local IslandLanes lanes;            // note: per worker thread, rows reused across jobs
+  thread_local std::vector<uint32_t> order;  // the job's islands, largest first
+  thread_local std::vector<uint32_t> list;
+  order.assign(which.begin(), which.end());
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t x, uint32_t y) { return islands.contacts(x).size() > islands.contacts(y).size(); });
+  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
+  for (size_t g = 0; g < order.size(); g += IslandLanes::kLanes) {
+    const size_t count = std::min<size_t>(IslandLanes::kLanes, order.size() - g);
+    std::span<const uint32_t> group[IslandLanes::kLanes];
+    size_t total = 0;
+    for (size_t l = 0; l < count; ++l) total += (group[l] = islands.contacts(order[g + l])).size();
+    if (!IslandLanes::kSimd || 2 * total < 3 * group[0].size()) {
+      for (size_t l = 0; l < count; ++l) solveIsland(group[l], relax, settings);
+      continue;
+    }
+    lanes.solve(std::span<const std::span<const uint32_t>>(group, count), contacts_, extras_, bodies_, !relax, relax, iterations);
+    if (!relax && settings.shockPropagation)
+      for (size_t l = 0; l < count; ++l) {
+        list.assign(group[l].begin(), group[l].end());
+        shockSweep(list);
+      }
   }
 }
 
@@ -399,7 +418,8 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
   islandJobStart_.push_back(uint32_t(smallIslands_.size()));
   jobs.parallelFor(0, uint32_t(islandJobStart_.size() - 1), 1, [&](uint32_t b, uint32_t e) {
     ProfileZone zone(profiler, relax ? "relax" : "island", stage + (relax ? 5 : 3));
-    for (uint32_t i = islandJobStart_[b]; i < islandJobStart_[e]; ++i) solveIsland(islands.contacts(smallIslands_[i]), relax, settings);
+    solveIslandsInLanes(islands, std::span<const uint32_t>(smallIslands_).subspan(islandJobStart_[b], islandJobStart_[e] - islandJobStart_[b]),
+                        relax, settings);
   });
   coloured_ = !relax;
   return stats;

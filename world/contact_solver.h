@@ -81,10 +81,10 @@ class ContactSolver {
   void warmStart(const SolverContact& s, SolverBody& a, SolverBody& b);
   void solveContact(uint32_t k, bool relax) { solveContact(k, relax, bodies_[contacts_[k].a], bodies_[contacts_[k].b]); }
   void solveContact(uint32_t k, bool relax, SolverBody& a, SolverBody& b);
-  void resistRolling(const SolverContact& s, SolverContactExtras& x, SolverBody& a, SolverBody& b);
   void solveContactShock(uint32_t k);
   void shockSweep(std::vector<uint32_t>& contacts);
   void solveIsland(std::span<const uint32_t> island, bool relax, const SceneSettings& settings);
+  void solveIslandsInLanes(const Islands& islands, std::span<const uint32_t> which, bool relax, const SceneSettings& settings);
   // `wave` numbers the island's waves (colours and serial steps, each a dependent step of
   // the solve) across the islands of one solve, for their profiling stages.
   // `colouring` is the island's colouring, made here unless `coloured` (the relax pass reuses

@@ -88,6 +88,19 @@ inline void updateContactScalar(SolverContact& s, bool relax, SolverBody& a, Sol
   s.lambdaT2 = lambdaT2;
 }
 
+/// Rolling resistance, after the contact's update: the relative spin about the two tangent axes
+/// (rolling, not spinning about the normal) is opposed by an angular impulse within a cone of
+/// rolling x lambdaN, as friction opposes sliding. Without it a capsule that lands spinning about
+/// its axis rolls forever and never sleeps.
+inline void resistRolling(const SolverContact& s, SolverContactExtras& x, SolverBody& a, SolverBody& b) {
+  const Vec3f w = a.w - b.w;
+  const float o1 = x.lambdaR1, o2 = x.lambdaR2;
+  clampToFrictionCone(o1 - x.massR[0] * w.dot(s.t1), o2 - x.massR[1] * w.dot(s.t2), s.rolling * s.lambdaN, x.lambdaR1, x.lambdaR2);
+  const float d1 = x.lambdaR1 - o1, d2 = x.lambdaR2 - o2;
+  if (a.dynamic) a.w += x.rollA[0] * d1 + x.rollA[1] * d2;
+  if (b.dynamic) b.w -= x.rollB[0] * d1 + x.rollB[1] * d2;
+}
+
 #if defined(__SSE2__)
 namespace sse_contact {
 
