@@ -254,34 +254,45 @@ void ContactSolver::solveIsland(std::span<const uint32_t> island, bool relax, co
   }
 }
 
-// A job's islands, four at a time in the lanes of IslandLanes (the same bits as one by one):
-// largest first, so that the islands sharing the lanes are of similar sizes. An island left
-// alone, or among much smaller ones, is solved on its own (a row of lanes costs about 1.5
-// contact updates: lanes pay once they are busy).
+// A job's islands in the lanes of IslandLanes (the same bits as one by one): a larger island
+// regrouped by level on its own when that fills the lanes (a pile), the rest four at a time,
+// largest first so that the islands sharing the lanes are of similar sizes. Islands left alone,
+// or among much smaller ones, are solved on their own (a row of lanes costs about 1.5 contact
+// updates: lanes pay once they are busy).
 void ContactSolver::solveIslandsInLanes(const Islands& islands, std::span<const uint32_t> which, bool relax,
                                         const SceneSettings& settings) {
   thread_local IslandLanes lanes;            // note: per worker thread, rows reused across jobs
-  thread_local std::vector<uint32_t> order;  // the job's islands, largest first
+  thread_local std::vector<uint32_t> order;  // the job's islands to solve four at a time, largest first
   thread_local std::vector<uint32_t> list;
-  order.assign(which.begin(), which.end());
+  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
+  const auto shock = [&](std::span<const uint32_t> island) {
+    if (relax || !settings.shockPropagation) return;
+    list.assign(island.begin(), island.end());
+    shockSweep(list);
+  };
+  order.clear();
+  for (uint32_t i : which) {
+    const std::span<const uint32_t> island = islands.contacts(i);
+    if (IslandLanes::kSimd && island.size() >= kLaneRegroupContacts &&
+        lanes.solveOne(island, contacts_, extras_, bodies_, !relax, relax, iterations)) {
+      shock(island);
+      continue;
+    }
+    order.push_back(i);
+  }
   std::stable_sort(order.begin(), order.end(),
                    [&](uint32_t x, uint32_t y) { return islands.contacts(x).size() > islands.contacts(y).size(); });
-  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
   for (size_t g = 0; g < order.size(); g += IslandLanes::kLanes) {
     const size_t count = std::min<size_t>(IslandLanes::kLanes, order.size() - g);
     std::span<const uint32_t> group[IslandLanes::kLanes];
     size_t total = 0;
     for (size_t l = 0; l < count; ++l) total += (group[l] = islands.contacts(order[g + l])).size();
-    if (!IslandLanes::kSimd || 2 * total < 3 * group[0].size()) {
+    if (!IslandLanes::kSimd || total * IslandLanes::kRowCostDen < group[0].size() * IslandLanes::kRowCostNum) {
       for (size_t l = 0; l < count; ++l) solveIsland(group[l], relax, settings);
       continue;
     }
     lanes.solve(std::span<const std::span<const uint32_t>>(group, count), contacts_, extras_, bodies_, !relax, relax, iterations);
-    if (!relax && settings.shockPropagation)
-      for (size_t l = 0; l < count; ++l) {
-        list.assign(group[l].begin(), group[l].end());
-        shockSweep(list);
-      }
+    for (size_t l = 0; l < count; ++l) shock(group[l]);
   }
 }
 

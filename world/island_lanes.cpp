@@ -61,7 +61,9 @@ struct LaneBodies {
   SolverBody* at[4];  // nullptr in an idle lane
   V3 v, w;
   __m128 invMass, dynamicWord, dynamic;  // dynamic: all ones where the body is dynamic
+  __m128 stillNegZero;                   // -0 where a lane's body is not dynamic, else +0
   uint32_t dynamicBits;
+  bool masked;  // some lane holds a real body that is not dynamic (idle lanes' results are dropped)
 
   LaneBodies(const uint32_t (&index)[4], uint32_t idle, SolverBody* bodies) {
     const float* in[4];
@@ -79,18 +81,36 @@ struct LaneBodies {
     dynamicWord = s3;
     const __m128i still = _mm_cmpeq_epi32(_mm_castps_si128(s3), _mm_setzero_si128());
     dynamic = _mm_castsi128_ps(_mm_xor_si128(still, _mm_set1_epi32(-1)));
+    stillNegZero = _mm_andnot_ps(dynamic, _mm_set1_ps(-0.f));
     dynamicBits = uint32_t(_mm_movemask_ps(dynamic));
+    uint32_t real = 0;
+    for (int l = 0; l < 4; ++l) real |= uint32_t(at[l] != nullptr) << l;
+    masked = (real & ~dynamicBits) != 0;
   }
-  // Impulse `lambda` along dir with angular response ang: + for side a, - for side b.
+  // Impulse `lambda` along dir with angular response ang: + for side a, - for side b. A body
+  // that is not dynamic keeps its velocity bits: it gains -0 (x + -0 == x for every x, +0 and
+  // -0 included) or loses +0 (x - +0 == x), as the scalar code's `if (dynamic)` leaves it.
   template <bool kPlus>
   void apply(V3 dir, V3 ang, __m128 lambda) {
     const __m128 scaled = _mm_mul_ps(lambda, invMass);
+    V3 dv = mul(dir, scaled), dw = mul(ang, lambda);
+    if (masked) {
+      if constexpr (kPlus) {
+        dv = {_mm_or_ps(_mm_and_ps(dynamic, dv.x), stillNegZero), _mm_or_ps(_mm_and_ps(dynamic, dv.y), stillNegZero),
+              _mm_or_ps(_mm_and_ps(dynamic, dv.z), stillNegZero)};
+        dw = {_mm_or_ps(_mm_and_ps(dynamic, dw.x), stillNegZero), _mm_or_ps(_mm_and_ps(dynamic, dw.y), stillNegZero),
+              _mm_or_ps(_mm_and_ps(dynamic, dw.z), stillNegZero)};
+      } else {
+        dv = {_mm_and_ps(dynamic, dv.x), _mm_and_ps(dynamic, dv.y), _mm_and_ps(dynamic, dv.z)};
+        dw = {_mm_and_ps(dynamic, dw.x), _mm_and_ps(dynamic, dw.y), _mm_and_ps(dynamic, dw.z)};
+      }
+    }
     if constexpr (kPlus) {
-      v = select(dynamic, add(v, mul(dir, scaled)), v);
-      w = select(dynamic, add(w, mul(ang, lambda)), w);
+      v = add(v, dv);
+      w = add(w, dw);
     } else {
-      v = select(dynamic, sub(v, mul(dir, scaled)), v);
-      w = select(dynamic, sub(w, mul(ang, lambda)), w);
+      v = sub(v, dv);
+      w = sub(w, dw);
     }
   }
   void store() const {
@@ -117,88 +137,154 @@ inline V3 relative(const LaneBodies& a, const LaneBodies& b, V3 rA, V3 rB) {
 }  // namespace
 #endif
 
-void IslandLanes::fillRows(std::span<const std::span<const uint32_t>> islands, std::span<const SolverContact> contacts,
-                           std::span<const SolverContactExtras> extras, bool relax, uint32_t longest) {
-  rows_.resize(longest);
-  std::memset(static_cast<void*>(rows_.data()), 0, size_t(longest) * sizeof(Row));
+void IslandLanes::RowSet::fill(std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
+                               std::span<const SolverContactExtras> extras, bool relax) {
+  const size_t count = slots.size() / kLanes;
+  rows.resize(count);
+  std::memset(static_cast<void*>(rows.data()), 0, count * sizeof(Row));
   bool anyRolls = false;
-  for (uint32_t r = 0; r < longest; ++r)
-    for (int l = 0; l < 4; ++l) rows_[r].a[l] = rows_[r].b[l] = kIdleBody;
-  for (uint32_t l = 0; l < uint32_t(islands.size()); ++l) {
-    const std::span<const uint32_t> island = islands[l];
-    for (uint32_t r = 0; r < uint32_t(island.size()); ++r) {
-      const SolverContact& s = contacts[island[r]];
-      Row& row = rows_[r];
-      row.a[l] = s.a;
-      row.b[l] = s.b;
+  for (size_t i = 0; i < slots.size(); ++i) {
+    Row& row = rows[i / kLanes];
+    const uint32_t l = uint32_t(i % kLanes);
+    if (slots[i] == kNone) {
+      row.a[l] = row.b[l] = kIdleBody;
+      continue;
+    }
+    const SolverContact& s = contacts[slots[i]];
+    row.a[l] = s.a;
+    row.b[l] = s.b;
+    for (int k = 0; k < 3; ++k) {
+      row.n[k][l] = s.normal[k];
+      row.rA[k][l] = s.rA[k];
+      row.rB[k][l] = s.rB[k];
+      row.t1[k][l] = s.t1[k];
+      row.t2[k][l] = s.t2[k];
+      for (int d = 0; d < 3; ++d) {
+        row.angA[d][k][l] = s.angA[d][k];
+        row.angB[d][k][l] = s.angB[d][k];
+      }
+    }
+    row.bias[l] = relax ? s.relaxBias : s.bias;
+    row.friction[l] = s.friction;
+    row.mass[0][l] = s.massN;
+    row.mass[1][l] = s.massT1;
+    row.mass[2][l] = s.massT2;
+    row.lambda[0][l] = s.lambdaN;
+    row.lambda[1][l] = s.lambdaT1;
+    row.lambda[2][l] = s.lambdaT2;
+    if (s.rolling > 0.f) {
+      row.rolls |= 1u << l;
+      anyRolls = true;
+    }
+  }
+  roll.clear();
+  if (!anyRolls) return;
+  roll.resize(count);
+  std::memset(static_cast<void*>(roll.data()), 0, count * sizeof(RollRow));
+  for (size_t i = 0; i < slots.size(); ++i) {
+    if (slots[i] == kNone || !(contacts[slots[i]].rolling > 0.f)) continue;
+    const SolverContact& s = contacts[slots[i]];
+    const SolverContactExtras& x = extras[slots[i]];
+    RollRow& row = roll[i / kLanes];
+    const uint32_t l = uint32_t(i % kLanes);
+    row.rolling[l] = s.rolling;
+    for (int t = 0; t < 2; ++t) {
+      row.massR[t][l] = x.massR[t];
       for (int k = 0; k < 3; ++k) {
-        row.n[k][l] = s.normal[k];
-        row.rA[k][l] = s.rA[k];
-        row.rB[k][l] = s.rB[k];
-        row.t1[k][l] = s.t1[k];
-        row.t2[k][l] = s.t2[k];
-        for (int d = 0; d < 3; ++d) {
-          row.angA[d][k][l] = s.angA[d][k];
-          row.angB[d][k][l] = s.angB[d][k];
-        }
-      }
-      row.bias[l] = relax ? s.relaxBias : s.bias;
-      row.friction[l] = s.friction;
-      row.mass[0][l] = s.massN;
-      row.mass[1][l] = s.massT1;
-      row.mass[2][l] = s.massT2;
-      row.lambda[0][l] = s.lambdaN;
-      row.lambda[1][l] = s.lambdaT1;
-      row.lambda[2][l] = s.lambdaT2;
-      if (s.rolling > 0.f) {
-        row.rolls |= 1u << l;
-        anyRolls = true;
+        row.rollA[t][k][l] = x.rollA[t][k];
+        row.rollB[t][k][l] = x.rollB[t][k];
       }
     }
+    row.lambdaR[0][l] = x.lambdaR1;
+    row.lambdaR[1][l] = x.lambdaR2;
   }
-  if (!anyRolls) {
-    roll_.clear();
-    return;
-  }
-  roll_.resize(longest);
-  std::memset(static_cast<void*>(roll_.data()), 0, size_t(longest) * sizeof(RollRow));
-  for (uint32_t l = 0; l < uint32_t(islands.size()); ++l) {
-    const std::span<const uint32_t> island = islands[l];
-    for (uint32_t r = 0; r < uint32_t(island.size()); ++r) {
-      const SolverContact& s = contacts[island[r]];
-      if (!(s.rolling > 0.f)) continue;
-      const SolverContactExtras& x = extras[island[r]];
-      RollRow& row = roll_[r];
-      row.rolling[l] = s.rolling;
-      for (int t = 0; t < 2; ++t) {
-        row.massR[t][l] = x.massR[t];
-        for (int k = 0; k < 3; ++k) {
-          row.rollA[t][k][l] = x.rollA[t][k];
-          row.rollB[t][k][l] = x.rollB[t][k];
-        }
-      }
-      row.lambdaR[0][l] = x.lambdaR1;
-      row.lambdaR[1][l] = x.lambdaR2;
+}
+
+void IslandLanes::RowSet::writeBack(std::span<const uint32_t> slots, std::span<SolverContact> contacts,
+                                    std::span<SolverContactExtras> extras) const {
+  for (size_t i = 0; i < slots.size(); ++i) {
+    if (slots[i] == kNone) continue;
+    const Row& row = rows[i / kLanes];
+    const uint32_t l = uint32_t(i % kLanes);
+    SolverContact& s = contacts[slots[i]];
+    s.lambdaN = row.lambda[0][l];
+    s.lambdaT1 = row.lambda[1][l];
+    s.lambdaT2 = row.lambda[2][l];
+    if ((row.rolls >> l) & 1) {
+      extras[slots[i]].lambdaR1 = roll[i / kLanes].lambdaR[0][l];
+      extras[slots[i]].lambdaR2 = roll[i / kLanes].lambdaR[1][l];
     }
   }
+}
+
+void IslandLanes::carryImpulses(const RowSet& from, std::span<const uint32_t> fromAt, RowSet& to, std::span<const uint32_t> toAt) {
+  const bool rolls = !from.roll.empty();
+  for (size_t p = 0; p < fromAt.size(); ++p) {
+    const uint32_t f = fromAt[p], t = toAt[p];
+    const Row& src = from.rows[f / kLanes];
+    Row& dst = to.rows[t / kLanes];
+    for (int d = 0; d < 3; ++d) dst.lambda[d][t % kLanes] = src.lambda[d][f % kLanes];
+    if (rolls)
+      for (int d = 0; d < 2; ++d) to.roll[t / kLanes].lambdaR[d][t % kLanes] = from.roll[f / kLanes].lambdaR[d][f % kLanes];
+  }
+}
+
+uint32_t IslandLanes::levelRows(std::span<const uint32_t> order, std::span<const SolverContact> contacts,
+                                std::span<const SolverBody> bodies, std::vector<uint32_t>& out, std::vector<uint32_t>& at) {
+  const uint32_t n = uint32_t(order.size());
+  if (bodyLevel_.size() < bodies.size()) bodyLevel_.resize(bodies.size(), 0);
+  levelOf_.resize(n);
+  uint32_t levels = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    // note: only dynamic bodies order updates: the others are read, never written.
+    const SolverContact& s = contacts[order[i]];
+    const bool dynA = bodies[s.a].dynamic != 0, dynB = bodies[s.b].dynamic != 0;
+    const uint32_t level = std::max(dynA ? bodyLevel_[s.a] : 0u, dynB ? bodyLevel_[s.b] : 0u);
+    levelOf_[i] = level;
+    if (dynA) bodyLevel_[s.a] = level + 1;
+    if (dynB) bodyLevel_[s.b] = level + 1;
+    levels = std::max(levels, level + 1);
+  }
+  for (uint32_t i = 0; i < n; ++i) bodyLevel_[contacts[order[i]].a] = bodyLevel_[contacts[order[i]].b] = 0;
+  // Each level's contacts in the pass's order, kLanes a row; a level's last row may idle lanes.
+  levelStart_.assign(levels + 1, 0);
+  for (uint32_t i = 0; i < n; ++i) ++levelStart_[levelOf_[i] + 1];
+  uint32_t rows = 0;
+  for (uint32_t level = 0; level < levels; ++level) {
+    const uint32_t size = levelStart_[level + 1];
+    levelStart_[level + 1] = levelStart_[level] + (size + kLanes - 1) / kLanes * kLanes;  // slots, row aligned
+    rows += (size + kLanes - 1) / kLanes;
+  }
+  out.assign(size_t(rows) * kLanes, kNone);
+  at.resize(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t slot = levelStart_[levelOf_[i]]++;
+    out[slot] = order[i];
+    at[i] = slot;
+  }
+  return rows;
 }
 
 #if defined(__SSE2__)
-void IslandLanes::warmStartRow(const Row& row, SolverBody* bodies) const {
-  LaneBodies a(row.a, kIdleBody, bodies), b(row.b, kIdleBody, bodies);
-  const V3 dirs[3] = {load3(row.n), load3(row.t1), load3(row.t2)};
-  for (int d = 0; d < 3; ++d) {
-    const __m128 lambda = load(row.lambda[d]);
-    a.apply<true>(dirs[d], load3(row.angA[d]), lambda);
-    b.apply<false>(dirs[d], load3(row.angB[d]), lambda);
+void IslandLanes::RowSet::warmStart(SolverBody* bodies) const {
+  for (const Row& row : rows) {
+    LaneBodies a(row.a, kIdleBody, bodies), b(row.b, kIdleBody, bodies);
+    const V3 dirs[3] = {load3(row.n), load3(row.t1), load3(row.t2)};
+    for (int d = 0; d < 3; ++d) {
+      const __m128 lambda = load(row.lambda[d]);
+      a.apply<true>(dirs[d], load3(row.angA[d]), lambda);
+      b.apply<false>(dirs[d], load3(row.angB[d]), lambda);
+    }
+    a.store();
+    b.store();
   }
-  a.store();
-  b.store();
 }
 
+namespace {
 // updateContact (then resistRolling where the lane's contact rolls), lane by lane.
-void IslandLanes::updateRow(Row& row, RollRow* roll, SolverBody* bodies) const {
-  LaneBodies a(row.a, kIdleBody, bodies), b(row.b, kIdleBody, bodies);
+template <class Row, class RollRow>
+void updateRow(Row& row, RollRow* roll, SolverBody* bodies, uint32_t idle) {
+  LaneBodies a(row.a, idle, bodies), b(row.b, idle, bodies);
   const V3 n = load3(row.n), rA = load3(row.rA), rB = load3(row.rB);
   const __m128 oldN = load(row.lambda[0]);
   const __m128 lambdaN =
@@ -241,6 +327,16 @@ void IslandLanes::updateRow(Row& row, RollRow* roll, SolverBody* bodies) const {
   a.store();
   b.store();
 }
+}  // namespace
+
+void IslandLanes::RowSet::pass(bool reversed, SolverBody* bodies) {
+  const size_t count = rows.size();
+  const bool rolls = !roll.empty();
+  for (size_t j = 0; j < count; ++j) {
+    const size_t r = reversed ? count - 1 - j : j;
+    updateRow(rows[r], rolls ? &roll[r] : nullptr, bodies, kIdleBody);
+  }
+}
 #endif
 
 void IslandLanes::solve(std::span<const std::span<const uint32_t>> islands, std::span<SolverContact> contacts,
@@ -251,31 +347,14 @@ void IslandLanes::solve(std::span<const std::span<const uint32_t>> islands, std:
   uint32_t longest = 0;
   for (const std::span<const uint32_t>& island : islands) longest = std::max(longest, uint32_t(island.size()));
   if (longest == 0) return;
-  fillRows(islands, contacts, extras, relax, longest);
-  SolverBody* const body = bodies.data();
-  const bool rolls = !roll_.empty();
-  if (warmStart)
-    for (uint32_t r = 0; r < longest; ++r) warmStartRow(rows_[r], body);
-  for (int it = 0; it < iterations; ++it) {
-    // Reversed passes run the rows from the longest island's end (see the header).
-    for (uint32_t j = 0; j < longest; ++j) {
-      const uint32_t r = (it & 1) ? longest - 1 - j : j;
-      updateRow(rows_[r], rolls ? &roll_[r] : nullptr, body);
-    }
-  }
-  for (uint32_t l = 0; l < uint32_t(islands.size()); ++l) {
-    const std::span<const uint32_t> island = islands[l];
-    for (uint32_t r = 0; r < uint32_t(island.size()); ++r) {
-      SolverContact& s = contacts[island[r]];
-      s.lambdaN = rows_[r].lambda[0][l];
-      s.lambdaT1 = rows_[r].lambda[1][l];
-      s.lambdaT2 = rows_[r].lambda[2][l];
-      if (rolls && ((rows_[r].rolls >> l) & 1)) {
-        extras[island[r]].lambdaR1 = roll_[r].lambdaR[0][l];
-        extras[island[r]].lambdaR2 = roll_[r].lambdaR[1][l];
-      }
-    }
-  }
+  slots_.assign(size_t(longest) * kLanes, kNone);
+  for (uint32_t l = 0; l < uint32_t(islands.size()); ++l)
+    for (uint32_t r = 0; r < uint32_t(islands[l].size()); ++r) slots_[size_t(r) * kLanes + l] = islands[l][r];
+  forward_.fill(slots_, contacts, extras, relax);
+  if (warmStart) forward_.warmStart(bodies.data());
+  // Reversed passes run the rows from the longest island's end (see the header).
+  for (int it = 0; it < iterations; ++it) forward_.pass((it & 1) != 0, bodies.data());
+  forward_.writeBack(slots_, contacts, extras);
 #else
   // One island after another, as ContactSolver solves an island alone.
   for (const std::span<const uint32_t>& island : islands) {
@@ -284,11 +363,45 @@ void IslandLanes::solve(std::span<const std::span<const uint32_t>> islands, std:
       for (uint32_t k : island) warmStartContact(contacts[k], bodies[contacts[k].a], bodies[contacts[k].b]);
     for (int it = 0; it < iterations; ++it)
       for (uint32_t j = 0; j < n; ++j) {
-        SolverContact& s = contacts[island[(it & 1) ? n - 1 - j : j]];
-        updateContact(s, relax, bodies[s.a], bodies[s.b]);
-        if (s.rolling > 0.f) resistRolling(s, extras[island[(it & 1) ? n - 1 - j : j]], bodies[s.a], bodies[s.b]);
+        const uint32_t k = island[(it & 1) ? n - 1 - j : j];
+        updateContact(contacts[k], relax, bodies[contacts[k].a], bodies[contacts[k].b]);
+        if (contacts[k].rolling > 0.f) resistRolling(contacts[k], extras[k], bodies[contacts[k].a], bodies[contacts[k].b]);
       }
   }
+#endif
+}
+
+bool IslandLanes::solveOne(std::span<const uint32_t> island, std::span<SolverContact> contacts,
+                           std::span<SolverContactExtras> extras, std::span<SolverBody> bodies, bool warmStart, bool relax,
+                           int iterations) {
+#if defined(__SSE2__)
+  const uint32_t n = uint32_t(island.size());
+  if (n == 0) return false;
+  const uint32_t forwardRows = levelRows(island, contacts, bodies, slots_, forwardAt_);
+  if (uint64_t(forwardRows) * kRowCostNum >= uint64_t(n) * kRowCostDen) return false;
+  reversedOrder_.assign(island.rbegin(), island.rend());
+  levelRows(reversedOrder_, contacts, bodies, backwardSlots_, backwardAt_);
+  // backwardAt_ by the island's own positions, as forwardAt_ is.
+  std::reverse(backwardAt_.begin(), backwardAt_.end());
+  forward_.fill(slots_, contacts, extras, relax);
+  backward_.fill(backwardSlots_, contacts, extras, relax);
+  if (warmStart) forward_.warmStart(bodies.data());
+  bool inForward = true;  // which rows hold the impulses as they now are
+  for (int it = 0; it < iterations; ++it) {
+    const bool forwardPass = (it & 1) == 0;
+    if (forwardPass != inForward) {
+      if (forwardPass) carryImpulses(backward_, backwardAt_, forward_, forwardAt_);
+      else carryImpulses(forward_, forwardAt_, backward_, backwardAt_);
+      inForward = forwardPass;
+    }
+    (forwardPass ? forward_ : backward_).pass(false, bodies.data());
+  }
+  if (inForward) forward_.writeBack(slots_, contacts, extras);
+  else backward_.writeBack(backwardSlots_, contacts, extras);
+  return true;
+#else
+  (void)island, (void)contacts, (void)extras, (void)bodies, (void)warmStart, (void)relax, (void)iterations;
+  return false;
 #endif
 }
 

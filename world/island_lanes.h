@@ -18,11 +18,17 @@
 /// more than one (ship_refit solves ~6,600 contacts in ~2,000 islands of at most 18, ten
 /// passes a substep).
 ///
-/// A pass runs the rows of the four islands in lockstep: row r holds contact r of each island.
-/// Forward passes take rows 0, 1, ...; reversed passes (the alternate ones of symmetric
-/// Gauss-Seidel) take rows M-1, M-2, ... where M is the longest island's size, so a shorter
-/// island's lane idles through the rows past its end first and then runs its own contacts from
-/// its last to its first, as solving it alone would. Islands of similar sizes waste the least.
+/// A pass runs rows of four contacts that share no dynamic body:
+/// - solve(): up to four islands side by side, row r holding contact r of each. Forward passes
+///   take rows 0, 1, ...; reversed passes (the alternate ones of symmetric Gauss-Seidel) take
+///   rows M-1, M-2, ... where M is the longest island's size, so a shorter island's lane idles
+///   through the rows past its end first and then runs its own contacts from its last to its
+///   first, as solving it alone would. Islands of similar sizes waste the least.
+/// - solveOne(): one larger island (a pile), its contacts regrouped by level: a contact's level
+///   is one more than the last level at which either of its dynamic bodies was updated, in the
+///   pass's order, so contacts of one level share no dynamic body, and running the levels in
+///   order gives every body its updates in the pass's order. Each direction has its rows; the
+///   impulses follow a contact from one direction's rows to the other's between passes.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -50,6 +56,14 @@ class IslandLanes {
   /// dynamic bodies' velocities end as solving each island alone would leave them, bit for bit.
   void solve(std::span<const std::span<const uint32_t>> islands, std::span<SolverContact> contacts,
              std::span<SolverContactExtras> extras, std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations);
+  /// solve() of one island whose contacts are regrouped by level (see above), when that fills
+  /// the lanes well enough to pay (rows at most kMaxRowShare of the contacts); otherwise returns
+  /// false having changed nothing (solve it alone).
+  bool solveOne(std::span<const uint32_t> island, std::span<SolverContact> contacts, std::span<SolverContactExtras> extras,
+                std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations);
+  /// A row of lanes costs about 1.5 contact updates alone (callgrind): regrouping pays when
+  /// an island's rows are under 2/3 of its contacts.
+  static constexpr uint32_t kRowCostNum = 3, kRowCostDen = 2;
 
  private:
   /// Contact r of each island, field by field (lane l is island l's): what a pass reads. An
@@ -68,14 +82,29 @@ class IslandLanes {
     float rollA[2][3][4], rollB[2][3][4];  // [tangent][axis][lane]
   };
   static constexpr uint32_t kIdleBody = 0xFFFFFFFFu;
+  static constexpr uint32_t kNone = 0xFFFFFFFFu;  // an idle lane's contact
 
-  void fillRows(std::span<const std::span<const uint32_t>> islands, std::span<const SolverContact> contacts,
-                std::span<const SolverContactExtras> extras, bool relax, uint32_t longest);
-  void warmStartRow(const Row& row, SolverBody* bodies) const;
-  void updateRow(Row& row, RollRow* roll, SolverBody* bodies) const;
+  /// The rows of one pass order, laid out from slots: kLanes a row, each a contact index or kNone.
+  struct RowSet {
+    std::vector<Row> rows;
+    std::vector<RollRow> roll;  // empty when no contact rolls
+    void fill(std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
+              std::span<const SolverContactExtras> extras, bool relax);
+    void writeBack(std::span<const uint32_t> slots, std::span<SolverContact> contacts,
+                   std::span<SolverContactExtras> extras) const;
+    void warmStart(SolverBody* bodies) const;
+    void pass(bool reversed, SolverBody* bodies);
+  };
+  // The rows of `order`'s contacts by level into out (kLanes slots a row); at[i]: contact
+  // order[i]'s slot. Returns the row count.
+  uint32_t levelRows(std::span<const uint32_t> order, std::span<const SolverContact> contacts, std::span<const SolverBody> bodies,
+                     std::vector<uint32_t>& out, std::vector<uint32_t>& at);
+  // Copies the impulses of the island's contacts from one direction's rows to the other's.
+  static void carryImpulses(const RowSet& from, std::span<const uint32_t> fromAt, RowSet& to, std::span<const uint32_t> toAt);
 
-  std::vector<Row> rows_;
-  std::vector<RollRow> roll_;
+  RowSet forward_, backward_;
+  std::vector<uint32_t> slots_, backwardSlots_, forwardAt_, backwardAt_, reversedOrder_;
+  std::vector<uint32_t> bodyLevel_, levelOf_, levelStart_;  // levelRows() scratch (bodyLevel_: 0 between calls)
 };
 
 }  // namespace bw

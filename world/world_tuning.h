@@ -119,6 +119,10 @@ inline constexpr double kShockHeightEpsilon = 1e-3;
 /// Islands with more contacts than this are coloured and solved colour by colour on every
 /// thread; smaller ones are solved whole, one island per job.
 inline constexpr uint32_t kSplitContacts = 512;
+/// Islands of at least this many contacts are first offered to IslandLanes::solveOne (regrouped
+/// by level, the lanes of one register on one island); smaller ones share the lanes four
+/// islands at a time.
+inline constexpr uint32_t kLaneRegroupContacts = 16;
 /// Colours per split island (one bit each in a 64-bit mask); contacts left over form a last,
 /// serial group.
 inline constexpr uint32_t kMaxColours = 64;
