@@ -309,9 +309,10 @@ int32_t waveStage(int stage, uint32_t& wave) { return kWaveStageBase + stage * i
 
 // One big island (a pile) on every thread: colour by colour, each colour's contacts in parallel.
 // Iterations alternate the colour order like solveIsland alternates the contact order.
-void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, IslandColouring& colouring, bool coloured,
+void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint32_t split, bool coloured,
                                          const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
                                          JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave) {
+  IslandColouring& colouring = colourings_[split];
   const char* const name = relax ? "relax: colour" : "colour";
   if (!coloured) {
     const int32_t colourStage = waveStage(stage, wave);  // in this order: each call takes the next id
@@ -330,6 +331,7 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
     int32_t stageId;
     bool warmStart;
     uint32_t chunkSize;  // contacts per chunk
+    bool fill, writeBack;  // lanes: the colour's rows laid out before the wave, its impulses back after
   };
   std::vector<Wave> waves;
   std::vector<uint32_t> chunks;
@@ -338,6 +340,13 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
   // gave one thread a chunk more than another in most waves (crate_pile on two threads: ~100 us
   // of waiting in a frame's relax pass of ~420 us).
   const uint32_t members = uint32_t(jobs.threadCount());
+  // A colour's contacts share no dynamic body: with lanes, four at a time in rows (chunks of
+  // whole rows), laid out in the colour's first wave of this solve and written back in its last.
+  constexpr bool kLanes = IslandLanes::kSimd;
+  constexpr uint32_t kRow = IslandLanes::kLanes;
+  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
+  const int passes = iterations + (relax ? 0 : 1);
+  int passIndex = 0;
   const auto pass = [&](bool warmStart, bool reversed) {
     for (uint32_t i = 0; i < colours; ++i) {
       const uint32_t c = reversed ? colours - 1 - i : i;
@@ -346,16 +355,27 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
       if (c != kMaxColours) {
         const uint32_t perMember = (size + members * kColourGrain - 1) / (members * kColourGrain);
         chunkSize = std::max(kMinColourChunk, (size + members * perMember - 1) / std::max(members * perMember, 1u));
+        if (kLanes) chunkSize = (chunkSize + kRow - 1) / kRow * kRow;
       }
-      waves.push_back({c, waveStage(stage, wave), warmStart, chunkSize});
+      waves.push_back({c, waveStage(stage, wave), warmStart, chunkSize, passIndex == 0, passIndex == passes - 1});
       chunks.push_back(JobSystem::chunkCount(0, size, chunkSize));
     }
+    ++passIndex;
   };
   // note: colour by colour, each body gets its contacts' warm-start impulses in the order of
   // colouring.all(), as a serial pass over it would: the result is the same.
   if (!relax) pass(true, false);
-  const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
   for (int it = 0; it < iterations; ++it) pass(false, it & 1);
+  IslandLanes::Rows& rows = colourRows_[split];
+  std::vector<uint32_t>& rowStart = colourRowStart_[split];
+  if (kLanes) {
+    rowStart.assign(colours + 1, 0);
+    for (uint32_t c = 0; c < colours; ++c) {
+      const uint32_t size = c == kMaxColours ? 0 : uint32_t(colouring.colour(c).size());
+      rowStart[c + 1] = rowStart[c] + (size + kRow - 1) / kRow;
+    }
+    rows.reserve(rowStart[colours]);
+  }
   // The island's bodies into their slots, and back once the waves are done.
   const std::vector<uint32_t>& slotBodies = colouring.slotBodies();
   slots_.resize(slotBodies.size());
@@ -369,6 +389,33 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, Islan
     const uint32_t begin = chunk * v.chunkSize;
     const uint32_t end = std::min(uint32_t(group.size()), begin + v.chunkSize);
     ProfileZone zone(profiler, v.warmStart ? "warm start" : name, v.stageId, serial);
+    if (kLanes && !serial) {
+      // The chunk's rows: contacts begin .. end of the colour, kRow a row (the last may idle lanes).
+      const uint32_t first = rowStart[v.colour] + begin / kRow, last = rowStart[v.colour] + (end + kRow - 1) / kRow;
+      const auto laneSlots = [&](uint32_t r, uint32_t (&contact)[kRow], uint32_t (&a)[kRow], uint32_t (&b)[kRow]) {
+        for (uint32_t l = 0; l < kRow; ++l) {
+          const uint32_t j = (r - rowStart[v.colour]) * kRow + l;
+          const bool in = j < end;
+          contact[l] = in ? group[j] : IslandLanes::kNone;
+          a[l] = in ? slots[j].a : IslandLanes::kIdleBody;
+          b[l] = in ? slots[j].b : IslandLanes::kIdleBody;
+        }
+      };
+      uint32_t contact[kRow], a[kRow], b[kRow];
+      if (v.fill)
+        for (uint32_t r = first; r < last; ++r) {
+          laneSlots(r, contact, a, b);
+          rows.fill(r, contact, a, b, contacts_, extras_, relax);
+        }
+      if (v.warmStart) rows.warmStart(first, last, slots_.data());
+      else rows.pass(first, last, false, slots_.data());
+      if (v.writeBack)
+        for (uint32_t r = first; r < last; ++r) {
+          laneSlots(r, contact, a, b);
+          rows.writeBack(r, contact, contacts_, extras_);
+        }
+      return;
+    }
     for (uint32_t j = begin; j < end; ++j) {
       SolverBody& a = slots_[slots[j].a];
       SolverBody& b = slots_[slots[j].b];
@@ -402,8 +449,12 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
     const uint32_t size = uint32_t(islands.contacts(i).size());
     stats.largestIsland = std::max(stats.largestIsland, size);
     if (size > kSplitContacts) {
-      if (stats.splitIslands == colourings_.size()) colourings_.emplace_back();
-      solveIslandInColours(islands.contacts(i), colourings_[stats.splitIslands], reuse, motion, relax, settings, jobs,
+      if (stats.splitIslands == colourings_.size()) {
+        colourings_.emplace_back();
+        colourRows_.emplace_back();
+        colourRowStart_.emplace_back();
+      }
+      solveIslandInColours(islands.contacts(i), stats.splitIslands, reuse, motion, relax, settings, jobs,
                            profiler, stage + (relax ? 5 : 3), wave);
       ++stats.splitIslands;
     } else {

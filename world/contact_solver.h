@@ -20,6 +20,7 @@
 #include "jobs/profiler.h"
 #include "world/body_store.h"
 #include "world/broadphase.h"
+#include "world/island_lanes.h"
 #include "world/islands.h"
 #include "world/scene_description.h"
 #include "world/solver_contact.h"
@@ -89,7 +90,7 @@ class ContactSolver {
   // the solve) across the islands of one solve, for their profiling stages.
   // `colouring` is the island's colouring, made here unless `coloured` (the relax pass reuses
   // the solve's).
-  void solveIslandInColours(std::span<const uint32_t> island, IslandColouring& colouring, bool coloured,
+  void solveIslandInColours(std::span<const uint32_t> island, uint32_t split, bool coloured,
                             const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
                             JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave);
   // Contact i's impulses as the cache keeps them.
@@ -123,6 +124,10 @@ class ContactSolver {
   // The colourings of this substep's split islands, in solve order; valid for the relax pass
   // once the solve has made them (coloured_; prepare() resets it).
   std::vector<IslandColouring> colourings_;
+  // Their colours in rows of IslandLanes (a row: four contacts of one colour), same index; where
+  // each colour's rows start (the serial group has none).
+  std::vector<IslandLanes::Rows> colourRows_;
+  std::vector<std::vector<uint32_t>> colourRowStart_;
   bool coloured_ = false;
   ParallelSorter<CachedImpulse, CacheOrder> cacheSorter_;
   std::vector<uint8_t> cacheChunkSorted_;  // keepImpulses: per copy chunk, already in order

@@ -137,22 +137,33 @@ inline V3 relative(const LaneBodies& a, const LaneBodies& b, V3 rA, V3 rB) {
 }  // namespace
 #endif
 
-void IslandLanes::RowSet::fill(std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
-                               std::span<const SolverContactExtras> extras, bool relax) {
-  const size_t count = slots.size() / kLanes;
-  rows.resize(count);
-  std::memset(static_cast<void*>(rows.data()), 0, count * sizeof(Row));
-  bool anyRolls = false;
-  for (size_t i = 0; i < slots.size(); ++i) {
-    Row& row = rows[i / kLanes];
-    const uint32_t l = uint32_t(i % kLanes);
-    if (slots[i] == kNone) {
+void IslandLanes::Rows::reserve(uint32_t count) {
+  if (count <= capacity_) return;
+  // note: default-initialised (no zeroing): fill() writes every field of every lane it lays out.
+  rows_.reset(new Row[count]);
+  roll_.reset(new RollRow[count]);
+  capacity_ = count;
+}
+
+void IslandLanes::Rows::fill(uint32_t r, const uint32_t* slots, const uint32_t* a, const uint32_t* b,
+                             std::span<const SolverContact> contacts, std::span<const SolverContactExtras> extras, bool relax) {
+  BW_ASSERT(r < capacity_);
+  Row& row = rows_[r];
+  row.rolls = 0;
+  for (uint32_t l = 0; l < kLanes; ++l) {
+    if (slots[l] == kNone) {
       row.a[l] = row.b[l] = kIdleBody;
+      for (int k = 0; k < 3; ++k) {
+        row.n[k][l] = row.rA[k][l] = row.rB[k][l] = row.t1[k][l] = row.t2[k][l] = 0.f;
+        row.mass[k][l] = row.lambda[k][l] = 0.f;
+        for (int d = 0; d < 3; ++d) row.angA[d][k][l] = row.angB[d][k][l] = 0.f;
+      }
+      row.bias[l] = row.friction[l] = 0.f;
       continue;
     }
-    const SolverContact& s = contacts[slots[i]];
-    row.a[l] = s.a;
-    row.b[l] = s.b;
+    const SolverContact& s = contacts[slots[l]];
+    row.a[l] = a ? a[l] : s.a;
+    row.b[l] = b ? b[l] : s.b;
     for (int k = 0; k < 3; ++k) {
       row.n[k][l] = s.normal[k];
       row.rA[k][l] = s.rA[k];
@@ -172,61 +183,61 @@ void IslandLanes::RowSet::fill(std::span<const uint32_t> slots, std::span<const 
     row.lambda[0][l] = s.lambdaN;
     row.lambda[1][l] = s.lambdaT1;
     row.lambda[2][l] = s.lambdaT2;
-    if (s.rolling > 0.f) {
-      row.rolls |= 1u << l;
-      anyRolls = true;
-    }
+    if (s.rolling > 0.f) row.rolls |= 1u << l;
   }
-  roll.clear();
-  if (!anyRolls) return;
-  roll.resize(count);
-  std::memset(static_cast<void*>(roll.data()), 0, count * sizeof(RollRow));
-  for (size_t i = 0; i < slots.size(); ++i) {
-    if (slots[i] == kNone || !(contacts[slots[i]].rolling > 0.f)) continue;
-    const SolverContact& s = contacts[slots[i]];
-    const SolverContactExtras& x = extras[slots[i]];
-    RollRow& row = roll[i / kLanes];
-    const uint32_t l = uint32_t(i % kLanes);
-    row.rolling[l] = s.rolling;
+  if (!row.rolls) return;
+  RollRow& roll = roll_[r];
+  for (uint32_t l = 0; l < kLanes; ++l) {
+    const bool rolls = (row.rolls >> l) & 1;
+    const SolverContactExtras* x = rolls ? &extras[slots[l]] : nullptr;
+    roll.rolling[l] = rolls ? contacts[slots[l]].rolling : 0.f;
+    roll.lambdaR[0][l] = rolls ? x->lambdaR1 : 0.f;
+    roll.lambdaR[1][l] = rolls ? x->lambdaR2 : 0.f;
     for (int t = 0; t < 2; ++t) {
-      row.massR[t][l] = x.massR[t];
+      roll.massR[t][l] = rolls ? x->massR[t] : 0.f;
       for (int k = 0; k < 3; ++k) {
-        row.rollA[t][k][l] = x.rollA[t][k];
-        row.rollB[t][k][l] = x.rollB[t][k];
+        roll.rollA[t][k][l] = rolls ? x->rollA[t][k] : 0.f;
+        roll.rollB[t][k][l] = rolls ? x->rollB[t][k] : 0.f;
       }
     }
-    row.lambdaR[0][l] = x.lambdaR1;
-    row.lambdaR[1][l] = x.lambdaR2;
   }
 }
 
-void IslandLanes::RowSet::writeBack(std::span<const uint32_t> slots, std::span<SolverContact> contacts,
-                                    std::span<SolverContactExtras> extras) const {
-  for (size_t i = 0; i < slots.size(); ++i) {
-    if (slots[i] == kNone) continue;
-    const Row& row = rows[i / kLanes];
-    const uint32_t l = uint32_t(i % kLanes);
-    SolverContact& s = contacts[slots[i]];
+void IslandLanes::Rows::writeBack(uint32_t r, const uint32_t* slots, std::span<SolverContact> contacts,
+                                  std::span<SolverContactExtras> extras) const {
+  const Row& row = rows_[r];
+  for (uint32_t l = 0; l < kLanes; ++l) {
+    if (slots[l] == kNone) continue;
+    SolverContact& s = contacts[slots[l]];
     s.lambdaN = row.lambda[0][l];
     s.lambdaT1 = row.lambda[1][l];
     s.lambdaT2 = row.lambda[2][l];
     if ((row.rolls >> l) & 1) {
-      extras[slots[i]].lambdaR1 = roll[i / kLanes].lambdaR[0][l];
-      extras[slots[i]].lambdaR2 = roll[i / kLanes].lambdaR[1][l];
+      extras[slots[l]].lambdaR1 = roll_[r].lambdaR[0][l];
+      extras[slots[l]].lambdaR2 = roll_[r].lambdaR[1][l];
     }
   }
 }
 
-void IslandLanes::carryImpulses(const RowSet& from, std::span<const uint32_t> fromAt, RowSet& to, std::span<const uint32_t> toAt) {
-  const bool rolls = !from.roll.empty();
-  for (size_t p = 0; p < fromAt.size(); ++p) {
-    const uint32_t f = fromAt[p], t = toAt[p];
-    const Row& src = from.rows[f / kLanes];
-    Row& dst = to.rows[t / kLanes];
-    for (int d = 0; d < 3; ++d) dst.lambda[d][t % kLanes] = src.lambda[d][f % kLanes];
-    if (rolls)
-      for (int d = 0; d < 2; ++d) to.roll[t / kLanes].lambdaR[d][t % kLanes] = from.roll[f / kLanes].lambdaR[d][f % kLanes];
-  }
+void IslandLanes::Rows::carry(uint32_t from, Rows& other, uint32_t to) const {
+  const Row& src = rows_[from / kLanes];
+  Row& dst = other.rows_[to / kLanes];
+  const uint32_t f = from % kLanes, t = to % kLanes;
+  for (int d = 0; d < 3; ++d) dst.lambda[d][t] = src.lambda[d][f];
+  if ((src.rolls >> f) & 1)
+    for (int d = 0; d < 2; ++d) other.roll_[to / kLanes].lambdaR[d][t] = roll_[from / kLanes].lambdaR[d][f];
+}
+
+void IslandLanes::fillAll(Rows& rows, std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
+                          std::span<const SolverContactExtras> extras, bool relax) {
+  const uint32_t count = uint32_t(slots.size() / kLanes);
+  rows.reserve(count);
+  for (uint32_t r = 0; r < count; ++r) rows.fill(r, &slots[size_t(r) * kLanes], nullptr, nullptr, contacts, extras, relax);
+}
+
+void IslandLanes::writeBackAll(const Rows& rows, std::span<const uint32_t> slots, std::span<SolverContact> contacts,
+                               std::span<SolverContactExtras> extras) {
+  for (uint32_t r = 0; r < uint32_t(slots.size() / kLanes); ++r) rows.writeBack(r, &slots[size_t(r) * kLanes], contacts, extras);
 }
 
 uint32_t IslandLanes::levelRows(std::span<const uint32_t> order, std::span<const SolverContact> contacts,
@@ -266,8 +277,9 @@ uint32_t IslandLanes::levelRows(std::span<const uint32_t> order, std::span<const
 }
 
 #if defined(__SSE2__)
-void IslandLanes::RowSet::warmStart(SolverBody* bodies) const {
-  for (const Row& row : rows) {
+void IslandLanes::Rows::warmStart(uint32_t first, uint32_t last, SolverBody* bodies) const {
+  for (uint32_t r = first; r < last; ++r) {
+    const Row& row = rows_[r];
     LaneBodies a(row.a, kIdleBody, bodies), b(row.b, kIdleBody, bodies);
     const V3 dirs[3] = {load3(row.n), load3(row.t1), load3(row.t2)};
     for (int d = 0; d < 3; ++d) {
@@ -329,12 +341,10 @@ void updateRow(Row& row, RollRow* roll, SolverBody* bodies, uint32_t idle) {
 }
 }  // namespace
 
-void IslandLanes::RowSet::pass(bool reversed, SolverBody* bodies) {
-  const size_t count = rows.size();
-  const bool rolls = !roll.empty();
-  for (size_t j = 0; j < count; ++j) {
-    const size_t r = reversed ? count - 1 - j : j;
-    updateRow(rows[r], rolls ? &roll[r] : nullptr, bodies, kIdleBody);
+void IslandLanes::Rows::pass(uint32_t first, uint32_t last, bool reversed, SolverBody* bodies) {
+  for (uint32_t j = first; j < last; ++j) {
+    const uint32_t r = reversed ? first + last - 1 - j : j;
+    updateRow(rows_[r], &roll_[r], bodies, kIdleBody);
   }
 }
 #endif
@@ -350,11 +360,11 @@ void IslandLanes::solve(std::span<const std::span<const uint32_t>> islands, std:
   slots_.assign(size_t(longest) * kLanes, kNone);
   for (uint32_t l = 0; l < uint32_t(islands.size()); ++l)
     for (uint32_t r = 0; r < uint32_t(islands[l].size()); ++r) slots_[size_t(r) * kLanes + l] = islands[l][r];
-  forward_.fill(slots_, contacts, extras, relax);
-  if (warmStart) forward_.warmStart(bodies.data());
+  fillAll(forward_, slots_, contacts, extras, relax);
+  if (warmStart) forward_.warmStart(0, longest, bodies.data());
   // Reversed passes run the rows from the longest island's end (see the header).
-  for (int it = 0; it < iterations; ++it) forward_.pass((it & 1) != 0, bodies.data());
-  forward_.writeBack(slots_, contacts, extras);
+  for (int it = 0; it < iterations; ++it) forward_.pass(0, longest, (it & 1) != 0, bodies.data());
+  writeBackAll(forward_, slots_, contacts, extras);
 #else
   // One island after another, as ContactSolver solves an island alone.
   for (const std::span<const uint32_t>& island : islands) {
@@ -383,21 +393,25 @@ bool IslandLanes::solveOne(std::span<const uint32_t> island, std::span<SolverCon
   levelRows(reversedOrder_, contacts, bodies, backwardSlots_, backwardAt_);
   // backwardAt_ by the island's own positions, as forwardAt_ is.
   std::reverse(backwardAt_.begin(), backwardAt_.end());
-  forward_.fill(slots_, contacts, extras, relax);
-  backward_.fill(backwardSlots_, contacts, extras, relax);
-  if (warmStart) forward_.warmStart(bodies.data());
+  fillAll(forward_, slots_, contacts, extras, relax);
+  fillAll(backward_, backwardSlots_, contacts, extras, relax);
+  const uint32_t backwardRows = uint32_t(backwardSlots_.size() / kLanes);
+  if (warmStart) forward_.warmStart(0, forwardRows, bodies.data());
   bool inForward = true;  // which rows hold the impulses as they now are
   for (int it = 0; it < iterations; ++it) {
     const bool forwardPass = (it & 1) == 0;
     if (forwardPass != inForward) {
-      if (forwardPass) carryImpulses(backward_, backwardAt_, forward_, forwardAt_);
-      else carryImpulses(forward_, forwardAt_, backward_, backwardAt_);
+      for (uint32_t p = 0; p < n; ++p) {
+        if (forwardPass) backward_.carry(backwardAt_[p], forward_, forwardAt_[p]);
+        else forward_.carry(forwardAt_[p], backward_, backwardAt_[p]);
+      }
       inForward = forwardPass;
     }
-    (forwardPass ? forward_ : backward_).pass(false, bodies.data());
+    if (forwardPass) forward_.pass(0, forwardRows, false, bodies.data());
+    else backward_.pass(0, backwardRows, false, bodies.data());
   }
-  if (inForward) forward_.writeBack(slots_, contacts, extras);
-  else backward_.writeBack(backwardSlots_, contacts, extras);
+  if (inForward) writeBackAll(forward_, slots_, contacts, extras);
+  else writeBackAll(backward_, backwardSlots_, contacts, extras);
   return true;
 #else
   (void)island, (void)contacts, (void)extras, (void)bodies, (void)warmStart, (void)relax, (void)iterations;

@@ -30,6 +30,7 @@
 ///   order gives every body its updates in the pass's order. Each direction has its rows; the
 ///   impulses follow a contact from one direction's rows to the other's between passes.
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -65,44 +66,62 @@ class IslandLanes {
   /// an island's rows are under 2/3 of its contacts.
   static constexpr uint32_t kRowCostNum = 3, kRowCostDen = 2;
 
- private:
-  /// Contact r of each island, field by field (lane l is island l's): what a pass reads. An
-  /// idle lane holds zeros and a static body, so its arithmetic stays finite and writes nothing.
-  struct alignas(16) Row {
-    float n[3][4], bias[4], friction[4];
-    float rA[3][4], rB[3][4], t1[3][4], t2[3][4];
-    float angA[3][3][4], angB[3][3][4];  // [direction: n, t1, t2][axis][lane]
-    float mass[3][4], lambda[3][4];      // [direction][lane]
-    uint32_t a[4], b[4];                 // body indices; kIdleBody in an idle lane
-    uint32_t rolls;                      // lanes whose contact rolls (rolling > 0), one bit each
-  };
-  /// The rolling resistance of a row's contacts (filled for rows where some lane rolls).
-  struct alignas(16) RollRow {
-    float rolling[4], lambdaR[2][4], massR[2][4];
-    float rollA[2][3][4], rollB[2][3][4];  // [tangent][axis][lane]
-  };
-  static constexpr uint32_t kIdleBody = 0xFFFFFFFFu;
-  static constexpr uint32_t kNone = 0xFFFFFFFFu;  // an idle lane's contact
-
-  /// The rows of one pass order, laid out from slots: kLanes a row, each a contact index or kNone.
-  struct RowSet {
-    std::vector<Row> rows;
-    std::vector<RollRow> roll;  // empty when no contact rolls
-    void fill(std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
+  /// Rows of kLanes contacts that share no dynamic body, field by field (lane l of a row is one
+  /// contact): what a pass reads and updates. An idle lane holds zeros and a static body, so its
+  /// arithmetic stays finite and writes nothing. Used by solve(), solveOne() and a coloured
+  /// island's colours (any four contacts of one colour make a row).
+  class Rows {
+   public:
+    /// Room for `count` rows (their contents undefined until filled).
+    void reserve(uint32_t count);
+    /// Row r from contacts[slots[l]] (kNone: an idle lane), lanes 0..kLanes-1, its bodies at
+    /// a[l] and b[l] of the body records a pass is given, or the contacts' own a and b when null.
+    void fill(uint32_t r, const uint32_t* slots, const uint32_t* a, const uint32_t* b, std::span<const SolverContact> contacts,
               std::span<const SolverContactExtras> extras, bool relax);
-    void writeBack(std::span<const uint32_t> slots, std::span<SolverContact> contacts,
-                   std::span<SolverContactExtras> extras) const;
-    void warmStart(SolverBody* bodies) const;
-    void pass(bool reversed, SolverBody* bodies);
+    /// The impulses of row r's lanes back to their contacts.
+    void writeBack(uint32_t r, const uint32_t* slots, std::span<SolverContact> contacts, std::span<SolverContactExtras> extras) const;
+    /// warmStartContact on rows [first, last), in order.
+    void warmStart(uint32_t first, uint32_t last, SolverBody* bodies) const;
+    /// updateContact (and resistRolling where a lane's contact rolls) on rows [first, last),
+    /// forward or from last - 1 down.
+    void pass(uint32_t first, uint32_t last, bool reversed, SolverBody* bodies);
+    /// Copies contact impulses between rows: lane `from` of `this` to lane `to` of `other`
+    /// (slots numbered row * kLanes + lane).
+    void carry(uint32_t from, Rows& other, uint32_t to) const;
+
+   private:
+    struct alignas(16) Row {
+      float n[3][4], bias[4], friction[4];
+      float rA[3][4], rB[3][4], t1[3][4], t2[3][4];
+      float angA[3][3][4], angB[3][3][4];  // [direction: n, t1, t2][axis][lane]
+      float mass[3][4], lambda[3][4];      // [direction][lane]
+      uint32_t a[4], b[4];                 // body indices; kIdleBody in an idle lane
+      uint32_t rolls;                      // lanes whose contact rolls (rolling > 0), one bit each
+    };
+    /// The rolling resistance of a row's contacts (written only for rows where a lane rolls).
+    struct alignas(16) RollRow {
+      float rolling[4], lambdaR[2][4], massR[2][4];
+      float rollA[2][3][4], rollB[2][3][4];  // [tangent][axis][lane]
+    };
+    std::unique_ptr<Row[]> rows_;
+    std::unique_ptr<RollRow[]> roll_;
+    uint32_t capacity_ = 0;
   };
+  static constexpr uint32_t kNone = 0xFFFFFFFFu;  ///< an idle lane's slot
+  static constexpr uint32_t kIdleBody = 0xFFFFFFFFu;
+
+ private:
   // The rows of `order`'s contacts by level into out (kLanes slots a row); at[i]: contact
   // order[i]'s slot. Returns the row count.
   uint32_t levelRows(std::span<const uint32_t> order, std::span<const SolverContact> contacts, std::span<const SolverBody> bodies,
                      std::vector<uint32_t>& out, std::vector<uint32_t>& at);
-  // Copies the impulses of the island's contacts from one direction's rows to the other's.
-  static void carryImpulses(const RowSet& from, std::span<const uint32_t> fromAt, RowSet& to, std::span<const uint32_t> toAt);
+  // Rows laid out from slots (kLanes a row) into rows.
+  static void fillAll(Rows& rows, std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
+                      std::span<const SolverContactExtras> extras, bool relax);
+  static void writeBackAll(const Rows& rows, std::span<const uint32_t> slots, std::span<SolverContact> contacts,
+                           std::span<SolverContactExtras> extras);
 
-  RowSet forward_, backward_;
+  Rows forward_, backward_;
   std::vector<uint32_t> slots_, backwardSlots_, forwardAt_, backwardAt_, reversedOrder_;
   std::vector<uint32_t> bodyLevel_, levelOf_, levelStart_;  // levelRows() scratch (bodyLevel_: 0 between calls)
 };
