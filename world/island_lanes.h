@@ -1,22 +1,24 @@
 #pragma once
-/// Small islands solved four at a time, one island per SSE lane, with the bits of solving each
+/// Small islands solved eight at a time, one island per SIMD lane, with the bits of solving each
 /// alone (world/contact_update.h's scalar reference).
 ///
 ///   IslandLanes lanes;  // one per thread: its rows are reused from call to call
-///   const std::span<const uint32_t> four[] = {islandA, islandB, islandC, islandD};
-///   lanes.solve(four, contacts, extras, bodies, /*warmStart*/ true, /*relax*/ false, iterations);
+///   const std::span<const uint32_t> some[] = {islandA, islandB, islandC};  // up to kLanes
+///   lanes.solve(some, contacts, extras, bodies, /*warmStart*/ true, /*relax*/ false, iterations);
 ///
 /// Why it gives the same bits: a Gauss-Seidel solve's result depends only on the order in which
-/// each body receives its contacts' updates. Islands share no dynamic body, so solving four
+/// each body receives its contacts' updates. Islands share no dynamic body, so solving eight
 /// side by side, each lane taking its own island's contacts in its own order, leaves every body
 /// with the same sequence of float operations as solving the islands one after another. Each
 /// lane does the scalar code's operations in the scalar code's order (products and sums lane by
 /// lane, 3-vector dot products summed x + (y + z), std::max and the cone's select written as
 /// compares, so a -0 or a NaN comes out as the scalar code's does; -ffp-contract=off), and a
-/// body that is not dynamic is never written. Why it pays: one contact update is ~200
-/// instructions of dependent scalar-width work; four in the lanes of one register cost little
-/// more than one (ship_refit solves ~6,600 contacts in ~2,000 islands of at most 18, ten
-/// passes a substep).
+/// body that is not dynamic is never written (island_lanes_kernel.h). Why it pays: one contact
+/// update is ~200 instructions, each waiting on the one before through the bodies' velocities
+/// (a manifold's contacts share their two bodies); eight islands' updates in the lanes of one
+/// register wait no longer than one (ship_refit solves ~6,600 contacts in ~2,000 islands of at
+/// most 18, ten passes a substep). A row is eight lanes: one AVX2 register where the CPU has
+/// it, else two SSE2 ones (island_lanes_rows.h); the bits are the same.
 ///
 /// A pass runs rows of four contacts that share no dynamic body:
 /// - solve(): up to four islands side by side, row r holding contact r of each. Forward passes
@@ -34,13 +36,14 @@
 #include <span>
 #include <vector>
 
+#include "world/island_lanes_rows.h"
 #include "world/solver_contact.h"
 
 namespace bw {
 
 class IslandLanes {
  public:
-  static constexpr uint32_t kLanes = 4;
+  static constexpr uint32_t kLanes = lanes::kWidth;
   /// Whether this build solves in lanes (SSE2, every x86-64); without it solve() takes the
   /// islands one by one through the scalar reference.
   static constexpr bool kSimd =
@@ -90,25 +93,14 @@ class IslandLanes {
     void carry(uint32_t from, Rows& other, uint32_t to) const;
 
    private:
-    struct alignas(16) Row {
-      float n[3][4], bias[4], friction[4];
-      float rA[3][4], rB[3][4], t1[3][4], t2[3][4];
-      float angA[3][3][4], angB[3][3][4];  // [direction: n, t1, t2][axis][lane]
-      float mass[3][4], lambda[3][4];      // [direction][lane]
-      uint32_t a[4], b[4];                 // body indices; kIdleBody in an idle lane
-      uint32_t rolls;                      // lanes whose contact rolls (rolling > 0), one bit each
-    };
-    /// The rolling resistance of a row's contacts (written only for rows where a lane rolls).
-    struct alignas(16) RollRow {
-      float rolling[4], lambdaR[2][4], massR[2][4];
-      float rollA[2][3][4], rollB[2][3][4];  // [tangent][axis][lane]
-    };
+    using Row = lanes::Row;
+    using RollRow = lanes::RollRow;
     std::unique_ptr<Row[]> rows_;
     std::unique_ptr<RollRow[]> roll_;
     uint32_t capacity_ = 0;
   };
   static constexpr uint32_t kNone = 0xFFFFFFFFu;  ///< an idle lane's slot
-  static constexpr uint32_t kIdleBody = 0xFFFFFFFFu;
+  static constexpr uint32_t kIdleBody = lanes::kIdleBody;
 
  private:
   // The rows of `order`'s contacts by level into out (kLanes slots a row); at[i]: contact

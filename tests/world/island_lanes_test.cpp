@@ -1,9 +1,10 @@
-// Islands solved four at a time in SSE lanes (world/island_lanes.h) must leave every body and
+// Islands solved side by side in SIMD lanes (world/island_lanes.h) must leave every body and
 // every impulse with the bits of solving each island alone through the scalar reference
 // (warmStartScalar, updateContactScalar, resistRolling): every state hash depends on them.
 // Seeded islands of 0-40 contacts side by side (so lanes idle at either end of a pass), static
 // and kinematic bodies shared by all of them, rolling contacts in some lanes only, velocities of
-// -0, magnitudes from 1e-6 to 1e6, warm start on and off, the solve and the relax pass.
+// -0, magnitudes from 1e-6 to 1e6, warm start on and off, the solve and the relax pass; with the
+// AVX2 row kernels (where the CPU has them) and the SSE2 ones.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -135,43 +136,60 @@ void solveAlone(Scene& s, bool warmStart, bool relax, int iterations) {
 
 bool sameBits(const void* a, const void* b, size_t n) { return std::memcmp(a, b, n) == 0; }
 
-TEST(IslandLanes, GiveEachIslandTheBitsOfSolvingItAlone) {
-  std::mt19937 rng(58);
-  IslandLanes lanes;  // one instance across trials: its rows are reused, as on a worker thread
-  uint32_t trials = 0, rolled = 0, clampedCone = 0;
-  for (int trial = 0; trial < 400; ++trial) {
-    const float scale = std::pow(10.f, float(int(rng() % 13)) - 6.f);  // 1e-6 .. 1e6
-    const uint32_t islandCount = 1 + uint32_t(rng() % IslandLanes::kLanes);
-    Scene ref = randomScene(rng, islandCount, scale);
-    Scene laned = ref;
-    const bool relax = rng() % 3 == 0;
-    const bool warmStart = !relax && rng() % 4 != 0;
-    const int iterations = 1 + int(rng() % 10);
-    solveAlone(ref, warmStart, relax, iterations);
-    std::vector<std::span<const uint32_t>> spans;
-    for (const std::vector<uint32_t>& island : laned.islands) spans.emplace_back(island);
-    lanes.solve(spans, laned.contacts, laned.extras, laned.bodies, warmStart, relax, iterations);
-    ++trials;
-    ASSERT_TRUE(sameBits(ref.bodies.data(), laned.bodies.data(), ref.bodies.size() * sizeof(SolverBody)))
-        << "trial " << trial << ": bodies differ (scale " << scale << ", " << islandCount << " islands)";
-    for (size_t k = 0; k < ref.contacts.size(); ++k) {
-      const SolverContact& r = ref.contacts[k];
-      const SolverContact& q = laned.contacts[k];
-      ASSERT_TRUE(sameBits(&r.lambdaN, &q.lambdaN, 4) && sameBits(&r.lambdaT1, &q.lambdaT1, 4) &&
-                  sameBits(&r.lambdaT2, &q.lambdaT2, 4))
-          << "trial " << trial << ", contact " << k;
-      ASSERT_TRUE(sameBits(&ref.extras[k].lambdaR1, &laned.extras[k].lambdaR1, 4) &&
-                  sameBits(&ref.extras[k].lambdaR2, &laned.extras[k].lambdaR2, 4))
-          << "trial " << trial << ", contact " << k << "'s rolling impulses";
-      rolled += r.rolling > 0.f;
-      const float t = std::sqrt(r.lambdaT1 * r.lambdaT1 + r.lambdaT2 * r.lambdaT2);
-      clampedCone += r.lambdaN > 0.f && t >= 0.999f * r.friction * r.lambdaN;
-    }
+// Runs body with each row kernel this machine has: AVX2 (where the CPU has it), then SSE2.
+template <class Body>
+void forEachKernel(Body&& body) {
+  if (lanes::avx2()) {
+    SCOPED_TRACE("AVX2 kernels");
+    body();
   }
-  // The cases meant: rolling contacts and friction at its cone, in every run of the test.
-  EXPECT_GT(rolled, 1000u);
-  EXPECT_GT(clampedCone, 1000u);
-  EXPECT_EQ(trials, 400u);
+  lanes::preferSse2ForTests(true);
+  {
+    SCOPED_TRACE("SSE2 kernels");
+    body();
+  }
+  lanes::preferSse2ForTests(false);
+}
+
+TEST(IslandLanes, GiveEachIslandTheBitsOfSolvingItAlone) {
+  forEachKernel([&] {
+    std::mt19937 rng(58);
+    IslandLanes lanes;  // one instance across trials: its rows are reused, as on a worker thread
+    uint32_t trials = 0, rolled = 0, clampedCone = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+      const float scale = std::pow(10.f, float(int(rng() % 13)) - 6.f);  // 1e-6 .. 1e6
+      const uint32_t islandCount = 1 + uint32_t(rng() % IslandLanes::kLanes);
+      Scene ref = randomScene(rng, islandCount, scale);
+      Scene laned = ref;
+      const bool relax = rng() % 3 == 0;
+      const bool warmStart = !relax && rng() % 4 != 0;
+      const int iterations = 1 + int(rng() % 10);
+      solveAlone(ref, warmStart, relax, iterations);
+      std::vector<std::span<const uint32_t>> spans;
+      for (const std::vector<uint32_t>& island : laned.islands) spans.emplace_back(island);
+      lanes.solve(spans, laned.contacts, laned.extras, laned.bodies, warmStart, relax, iterations);
+      ++trials;
+      ASSERT_TRUE(sameBits(ref.bodies.data(), laned.bodies.data(), ref.bodies.size() * sizeof(SolverBody)))
+          << "trial " << trial << ": bodies differ (scale " << scale << ", " << islandCount << " islands)";
+      for (size_t k = 0; k < ref.contacts.size(); ++k) {
+        const SolverContact& r = ref.contacts[k];
+        const SolverContact& q = laned.contacts[k];
+        ASSERT_TRUE(sameBits(&r.lambdaN, &q.lambdaN, 4) && sameBits(&r.lambdaT1, &q.lambdaT1, 4) &&
+                    sameBits(&r.lambdaT2, &q.lambdaT2, 4))
+            << "trial " << trial << ", contact " << k;
+        ASSERT_TRUE(sameBits(&ref.extras[k].lambdaR1, &laned.extras[k].lambdaR1, 4) &&
+                    sameBits(&ref.extras[k].lambdaR2, &laned.extras[k].lambdaR2, 4))
+            << "trial " << trial << ", contact " << k << "'s rolling impulses";
+        rolled += r.rolling > 0.f;
+        const float t = std::sqrt(r.lambdaT1 * r.lambdaT1 + r.lambdaT2 * r.lambdaT2);
+        clampedCone += r.lambdaN > 0.f && t >= 0.999f * r.friction * r.lambdaN;
+      }
+    }
+    // The cases meant: rolling contacts and friction at its cone, in every run of the test.
+    EXPECT_GT(rolled, 1000u);
+    EXPECT_GT(clampedCone, 1000u);
+    EXPECT_EQ(trials, 400u);
+  });
 }
 
 bool sameResults(const Scene& a, const Scene& b) {
@@ -190,48 +208,52 @@ bool sameResults(const Scene& a, const Scene& b) {
 // chains (every contact waits on the one before: solveOne declines) to wide heaps (most rows
 // full). Whether it declines or solves, the result is the island's alone, bit for bit.
 TEST(IslandLanes, RegroupAPileByLevelWithTheBitsOfSolvingItAlone) {
-  std::mt19937 rng(59);
-  IslandLanes lanes;
-  uint32_t solved = 0, declined = 0;
-  for (int trial = 0; trial < 300; ++trial) {
-    const float scale = std::pow(10.f, float(int(rng() % 13)) - 6.f);
-    const uint32_t bodies = 2 + uint32_t(rng() % 200);
-    Scene ref = randomScene(rng, 1, scale, bodies, 1 + uint32_t(rng() % 600));
-    Scene laned = ref;
-    const bool relax = rng() % 3 == 0;
-    const bool warmStart = !relax && rng() % 4 != 0;
-    const int iterations = 1 + int(rng() % 10);
-    solveAlone(ref, warmStart, relax, iterations);
-    if (lanes.solveOne(laned.islands[0], laned.contacts, laned.extras, laned.bodies, warmStart, relax, iterations)) {
-      ++solved;
-    } else {
-      ++declined;
-      solveAlone(laned, warmStart, relax, iterations);  // declined: nothing may have changed
+  forEachKernel([&] {
+    std::mt19937 rng(59);
+    IslandLanes lanes;
+    uint32_t solved = 0, declined = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+      const float scale = std::pow(10.f, float(int(rng() % 13)) - 6.f);
+      const uint32_t bodies = 2 + uint32_t(rng() % 200);
+      Scene ref = randomScene(rng, 1, scale, bodies, 1 + uint32_t(rng() % 600));
+      Scene laned = ref;
+      const bool relax = rng() % 3 == 0;
+      const bool warmStart = !relax && rng() % 4 != 0;
+      const int iterations = 1 + int(rng() % 10);
+      solveAlone(ref, warmStart, relax, iterations);
+      if (lanes.solveOne(laned.islands[0], laned.contacts, laned.extras, laned.bodies, warmStart, relax, iterations)) {
+        ++solved;
+      } else {
+        ++declined;
+        solveAlone(laned, warmStart, relax, iterations);  // declined: nothing may have changed
+      }
+      ASSERT_TRUE(sameResults(ref, laned)) << "trial " << trial << " (" << bodies << " bodies, " << ref.contacts.size()
+                                           << " contacts, scale " << scale << ")";
     }
-    ASSERT_TRUE(sameResults(ref, laned)) << "trial " << trial << " (" << bodies << " bodies, " << ref.contacts.size()
-                                         << " contacts, scale " << scale << ")";
-  }
-  // Both outcomes, often.
-  EXPECT_GT(solved, 100u);
-  EXPECT_GT(declined, 20u);
+    // Both outcomes, often.
+    EXPECT_GT(solved, 100u);
+    EXPECT_GT(declined, 20u);
+  });
 }
 
 // A static or kinematic body several islands share is read in several lanes of one row and
 // must never be written, even when every lane's contact pushes on it.
 TEST(IslandLanes, NeverWriteABodyThatIsNotDynamic) {
-  std::mt19937 rng(7);
-  for (int trial = 0; trial < 50; ++trial) {
-    Scene s = randomScene(rng, IslandLanes::kLanes, 1.f);
-    std::vector<SolverBody> before = s.bodies;
-    std::vector<std::span<const uint32_t>> spans;
-    for (const std::vector<uint32_t>& island : s.islands) spans.emplace_back(island);
-    IslandLanes lanes;
-    lanes.solve(spans, s.contacts, s.extras, s.bodies, true, false, 8);
-    for (size_t i = 0; i < s.bodies.size(); ++i)
-      if (!before[i].dynamic) {
-        EXPECT_TRUE(sameBits(&before[i], &s.bodies[i], sizeof(SolverBody))) << "body " << i;
-      }
-  }
+  forEachKernel([&] {
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 50; ++trial) {
+      Scene s = randomScene(rng, IslandLanes::kLanes, 1.f);
+      std::vector<SolverBody> before = s.bodies;
+      std::vector<std::span<const uint32_t>> spans;
+      for (const std::vector<uint32_t>& island : s.islands) spans.emplace_back(island);
+      IslandLanes lanes;
+      lanes.solve(spans, s.contacts, s.extras, s.bodies, true, false, 8);
+      for (size_t i = 0; i < s.bodies.size(); ++i)
+        if (!before[i].dynamic) {
+          EXPECT_TRUE(sameBits(&before[i], &s.bodies[i], sizeof(SolverBody))) << "body " << i;
+        }
+    }
+  });
 }
 
 }  // namespace
