@@ -255,14 +255,14 @@ void ContactSolver::solveIsland(std::span<const uint32_t> island, bool relax, co
 }
 
 // A job's islands in the lanes of IslandLanes (the same bits as one by one): a larger island
-// regrouped by level on its own when that fills the lanes (a pile), the rest four at a time,
+// regrouped by level on its own when that fills the lanes (a pile), the rest kLanes at a time,
 // largest first so that the islands sharing the lanes are of similar sizes. Islands left alone,
-// or among much smaller ones, are solved on their own (a row of lanes costs about 1.5 contact
-// updates: lanes pay once they are busy).
+// or among much smaller ones, are solved on their own (lanes pay only once enough of them are
+// busy: IslandLanes::kRowCostNum).
 void ContactSolver::solveIslandsInLanes(const Islands& islands, std::span<const uint32_t> which, bool relax,
                                         const SceneSettings& settings) {
   thread_local IslandLanes lanes;            // note: per worker thread, rows reused across jobs
-  thread_local std::vector<uint32_t> order;  // the job's islands to solve four at a time, largest first
+  thread_local std::vector<uint32_t> order;  // the job's islands to solve side by side, largest first
   thread_local std::vector<uint32_t> list;
   const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
   const auto shock = [&](std::span<const uint32_t> island) {

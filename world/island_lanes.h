@@ -20,8 +20,8 @@
 /// most 18, ten passes a substep). A row is eight lanes: one AVX2 register where the CPU has
 /// it, else two SSE2 ones (island_lanes_rows.h); the bits are the same.
 ///
-/// A pass runs rows of four contacts that share no dynamic body:
-/// - solve(): up to four islands side by side, row r holding contact r of each. Forward passes
+/// A pass runs rows of kLanes contacts that share no dynamic body:
+/// - solve(): up to kLanes islands side by side, row r holding contact r of each. Forward passes
 ///   take rows 0, 1, ...; reversed passes (the alternate ones of symmetric Gauss-Seidel) take
 ///   rows M-1, M-2, ... where M is the longest island's size, so a shorter island's lane idles
 ///   through the rows past its end first and then runs its own contacts from its last to its
@@ -61,18 +61,20 @@ class IslandLanes {
   void solve(std::span<const std::span<const uint32_t>> islands, std::span<SolverContact> contacts,
              std::span<SolverContactExtras> extras, std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations);
   /// solve() of one island whose contacts are regrouped by level (see above), when that fills
-  /// the lanes well enough to pay (rows at most kMaxRowShare of the contacts); otherwise returns
-  /// false having changed nothing (solve it alone).
+  /// the lanes well enough to pay (see kRowCostNum); otherwise returns false having changed
+  /// nothing (solve it alone).
   bool solveOne(std::span<const uint32_t> island, std::span<SolverContact> contacts, std::span<SolverContactExtras> extras,
                 std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations);
-  /// A row of lanes costs about 1.5 contact updates alone (callgrind): regrouping pays when
-  /// an island's rows are under 2/3 of its contacts.
-  static constexpr uint32_t kRowCostNum = 3, kRowCostDen = 2;
+  /// Lanes are used where rows hold at least kRowCostNum / kRowCostDen contacts on average (an
+  /// island regrouped, or islands side by side): a row costs more than one contact's update
+  /// alone. monument's island stage, one thread, six runs: 56-74 us a frame at 1.5 contacts a
+  /// row, 50-64 at 3, 60-79 at 1; city_rain and ship_refit the same at 1.5 and 3.
+  static constexpr uint32_t kRowCostNum = 3, kRowCostDen = 1;
 
   /// Rows of kLanes contacts that share no dynamic body, field by field (lane l of a row is one
   /// contact): what a pass reads and updates. An idle lane holds zeros and a static body, so its
   /// arithmetic stays finite and writes nothing. Used by solve(), solveOne() and a coloured
-  /// island's colours (any four contacts of one colour make a row).
+  /// island's colours (any kLanes contacts of one colour make a row).
   class Rows {
    public:
     /// Room for `count` rows (their contents undefined until filled).

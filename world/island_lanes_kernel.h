@@ -10,7 +10,6 @@
 // cone's scale as a select, a body that is not dynamic never changed (the scalar code's
 // `if (dynamic)`). -ffp-contract=off: no fused multiply-adds on either side.
 #include <cstdint>
-#include <cstring>
 
 #include "world/island_lanes_rows.h"
 
