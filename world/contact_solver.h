@@ -68,8 +68,10 @@ class ContactSolver {
 
  private:
   /// Fewest pairs per job of prepare(): a contact costs ~100 ns, a pair up to manifoldSize of
-  /// them, so 32 pairs are several microseconds.
-  static constexpr uint32_t kMinPrepareGrain = 32;
+  /// them, so 16 pairs are several microseconds. 32 made crates_on_grid's ~365 pairs 11 jobs of
+  /// ~12 us (traced): the stage's span at 16 threads, and its work/span bound there 7.4-8.1x
+  /// against 7.6-8.1x at 16 (three runs each, session 39).
+  static constexpr uint32_t kMinPrepareGrain = 16;
   /// Fewest contacts per job of islands solved whole: one job per island made city_rain's ~280
   /// islands a frame ~280 jobs of ~1.6 us each (traced), a tenth of the stage's wall time in
   /// job overhead on one thread.
