@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "world/contact_update.h"
+#include "world/support/random_solver_contact.h"
 
 namespace bw {
 namespace {
@@ -39,24 +40,7 @@ Island randomIsland(std::mt19937& rng, uint32_t bodyCount, uint32_t contactCount
     s.a = uint32_t(rng() % bodyCount);
     do s.b = uint32_t(rng() % bodyCount);
     while (s.b == s.a);
-    s.normal = vec(1.f).normalized();
-    s.t1 = s.normal.unitOrthogonal();
-    s.t2 = s.normal.cross(s.t1);
-    s.bias = u(rng) * scale;
-    s.relaxBias = u(rng) * scale * 0.1f;
-    s.friction = pos(rng) * 1.2f;
-    s.rA = vec(scale);
-    s.rB = vec(scale);
-    for (int d = 0; d < 3; ++d) {
-      s.angA[d] = vec(pos(rng));
-      s.angB[d] = vec(pos(rng));
-    }
-    s.massN = pos(rng) * 5.f;
-    s.massT1 = pos(rng) * 5.f;
-    s.massT2 = pos(rng) * 5.f;
-    s.lambdaN = pos(rng) < 0.3f ? 0.f : pos(rng) * scale;
-    s.lambdaT1 = u(rng) * s.friction * s.lambdaN;
-    s.lambdaT2 = u(rng) * s.friction * s.lambdaN;
+    test::drawSolverContact(rng, scale, s);
   }
   return island;
 }

@@ -15,6 +15,7 @@
 
 #include "world/contact_update.h"
 #include "world/island_lanes.h"
+#include "world/support/random_solver_contact.h"
 
 namespace bw {
 namespace {
@@ -72,24 +73,7 @@ Scene randomScene(std::mt19937& rng, uint32_t islandCount, float scale, uint32_t
         while (s.b == s.a);
       }
       if (rng() % 2) std::swap(s.a, s.b);
-      s.normal = vec(1.f).normalized();
-      s.t1 = s.normal.unitOrthogonal();
-      s.t2 = s.normal.cross(s.t1);
-      s.bias = u(rng) * scale;
-      s.relaxBias = u(rng) * scale * 0.1f;
-      s.friction = unit(rng) * 1.2f;
-      s.rA = vec(scale);
-      s.rB = vec(scale);
-      for (int d = 0; d < 3; ++d) {
-        s.angA[d] = vec(unit(rng));
-        s.angB[d] = vec(unit(rng));
-      }
-      s.massN = unit(rng) * 5.f;
-      s.massT1 = unit(rng) * 5.f;
-      s.massT2 = unit(rng) * 5.f;
-      s.lambdaN = unit(rng) < 0.3f ? 0.f : unit(rng) * scale;
-      s.lambdaT1 = u(rng) * s.friction * s.lambdaN;
-      s.lambdaT2 = u(rng) * s.friction * s.lambdaN;
+      test::drawSolverContact(rng, scale, s);
       if (rng() % 6 == 0) {
         // A contact that never pushes: its steps are zeros, whose signs a lane must keep as the
         // scalar code does (a body's -0 stays -0 only if nothing adds +0 to it).
