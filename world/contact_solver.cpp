@@ -340,8 +340,8 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint3
   // gave one thread a chunk more than another in most waves (crate_pile on two threads: ~100 us
   // of waiting in a frame's relax pass of ~420 us).
   const uint32_t members = uint32_t(jobs.threadCount());
-  // A colour's contacts share no dynamic body: with lanes, four at a time in rows (chunks of
-  // whole rows), laid out in the colour's first wave of this solve and written back in its last.
+  // A colour's contacts share no dynamic body: with lanes, kLanes of them a row (chunks of whole
+  // rows), laid out in the colour's first wave of this solve and written back in its last.
   constexpr bool kLanes = IslandLanes::kSimd;
   constexpr uint32_t kRow = IslandLanes::kLanes;
   const int iterations = relax ? settings.relaxIterations : settings.solverIterations;
@@ -389,32 +389,34 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint3
     const uint32_t begin = chunk * v.chunkSize;
     const uint32_t end = std::min(uint32_t(group.size()), begin + v.chunkSize);
     ProfileZone zone(profiler, v.warmStart ? "warm start" : name, v.stageId, serial);
-    if (kLanes && !serial) {
-      // The chunk's rows: contacts begin .. end of the colour, kRow a row (the last may idle lanes).
-      const uint32_t first = rowStart[v.colour] + begin / kRow, last = rowStart[v.colour] + (end + kRow - 1) / kRow;
-      const auto laneSlots = [&](uint32_t r, uint32_t (&contact)[kRow], uint32_t (&a)[kRow], uint32_t (&b)[kRow]) {
-        for (uint32_t l = 0; l < kRow; ++l) {
-          const uint32_t j = (r - rowStart[v.colour]) * kRow + l;
-          const bool in = j < end;
-          contact[l] = in ? group[j] : IslandLanes::kNone;
-          a[l] = in ? slots[j].a : IslandLanes::kIdleBody;
-          b[l] = in ? slots[j].b : IslandLanes::kIdleBody;
-        }
-      };
-      uint32_t contact[kRow], a[kRow], b[kRow];
-      if (v.fill)
-        for (uint32_t r = first; r < last; ++r) {
-          laneSlots(r, contact, a, b);
-          rows.fill(r, contact, a, b, contacts_, extras_, relax);
-        }
-      if (v.warmStart) rows.warmStart(first, last, slots_.data());
-      else rows.pass(first, last, false, slots_.data());
-      if (v.writeBack)
-        for (uint32_t r = first; r < last; ++r) {
-          laneSlots(r, contact, a, b);
-          rows.writeBack(r, contact, contacts_, extras_);
-        }
-      return;
+    if constexpr (kLanes) {
+      if (!serial) {
+        // The chunk's rows: contacts begin .. end of the colour, kRow a row (the last may idle lanes).
+        const uint32_t first = rowStart[v.colour] + begin / kRow, last = rowStart[v.colour] + (end + kRow - 1) / kRow;
+        const auto laneSlots = [&](uint32_t r, uint32_t (&contact)[kRow], uint32_t (&a)[kRow], uint32_t (&b)[kRow]) {
+          for (uint32_t l = 0; l < kRow; ++l) {
+            const uint32_t j = (r - rowStart[v.colour]) * kRow + l;
+            const bool in = j < end;
+            contact[l] = in ? group[j] : IslandLanes::kNone;
+            a[l] = in ? slots[j].a : IslandLanes::kIdleBody;
+            b[l] = in ? slots[j].b : IslandLanes::kIdleBody;
+          }
+        };
+        uint32_t contact[kRow], a[kRow], b[kRow];
+        if (v.fill)
+          for (uint32_t r = first; r < last; ++r) {
+            laneSlots(r, contact, a, b);
+            rows.fill(r, contact, a, b, contacts_, extras_, relax);
+          }
+        if (v.warmStart) rows.warmStart(first, last, slots_.data());
+        else rows.pass(first, last, false, slots_.data());
+        if (v.writeBack)
+          for (uint32_t r = first; r < last; ++r) {
+            laneSlots(r, contact, a, b);
+            rows.writeBack(r, contact, contacts_, extras_);
+          }
+        return;
+      }
     }
     for (uint32_t j = begin; j < end; ++j) {
       SolverBody& a = slots_[slots[j].a];
