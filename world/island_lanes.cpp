@@ -11,7 +11,6 @@
 #include <emmintrin.h>
 #endif
 
-
 namespace bw {
 
 // The kernels read SolverBody records as eight floats: v, invMass, w, the dynamic word.
@@ -22,9 +21,11 @@ static_assert(offsetof(SolverBody, v) == 0 && offsetof(SolverBody, invMass) == 1
 void IslandLanes::Rows::reserve(uint32_t count) {
   if (count <= capacity_) return;
   // note: default-initialised (no zeroing): fill() writes every field of every lane it lays out.
-  rows_.reset(new Row[count]);
-  roll_.reset(new RollRow[count]);
-  capacity_ = count;
+  // Grown by half again at least, so a frame whose islands grow a little allocates nothing.
+  const uint32_t grown = std::max(count, capacity_ + capacity_ / 2);
+  rows_.reset(new Row[grown]);
+  roll_.reset(new RollRow[grown]);
+  capacity_ = grown;
 }
 
 namespace {
