@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "world/contact_update.h"
-#include "world/island_lanes.h"
 #include "world/world_tuning.h"
 
 namespace bw {
@@ -258,7 +257,7 @@ void ContactSolver::solveIsland(std::span<const uint32_t> island, bool relax, co
 // regrouped by level on its own when that fills the lanes (a pile), the rest kLanes at a time,
 // largest first so that the islands sharing the lanes are of similar sizes. Islands left alone,
 // or among much smaller ones, are solved on their own (lanes pay only once enough of them are
-// busy: IslandLanes::kRowCostNum).
+// busy: IslandLanes::kMinContactsPerRow).
 void ContactSolver::solveIslandsInLanes(const Islands& islands, std::span<const uint32_t> which, bool relax,
                                         const SceneSettings& settings) {
   thread_local IslandLanes lanes;            // note: per worker thread, rows reused across jobs
@@ -280,14 +279,18 @@ void ContactSolver::solveIslandsInLanes(const Islands& islands, std::span<const 
     }
     order.push_back(i);
   }
-  std::stable_sort(order.begin(), order.end(),
-                   [&](uint32_t x, uint32_t y) { return islands.contacts(x).size() > islands.contacts(y).size(); });
+  // note: ties by island index (a total order: std::sort, where std::stable_sort asks the heap
+  // for a buffer on every call).
+  std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+    const size_t sx = islands.contacts(x).size(), sy = islands.contacts(y).size();
+    return sx > sy || (sx == sy && x < y);
+  });
   for (size_t g = 0; g < order.size(); g += IslandLanes::kLanes) {
     const size_t count = std::min<size_t>(IslandLanes::kLanes, order.size() - g);
     std::span<const uint32_t> group[IslandLanes::kLanes];
     size_t total = 0;
     for (size_t l = 0; l < count; ++l) total += (group[l] = islands.contacts(order[g + l])).size();
-    if (!IslandLanes::kSimd || total * IslandLanes::kRowCostDen < group[0].size() * IslandLanes::kRowCostNum) {
+    if (!IslandLanes::kSimd || total < group[0].size() * IslandLanes::kMinContactsPerRow) {
       for (size_t l = 0; l < count; ++l) solveIsland(group[l], relax, settings);
       continue;
     }

@@ -126,7 +126,7 @@ class ContactSolver {
   // The colourings of this substep's split islands, in solve order; valid for the relax pass
   // once the solve has made them (coloured_; prepare() resets it).
   std::vector<IslandColouring> colourings_;
-  // Their colours in rows of IslandLanes (a row: four contacts of one colour), same index; where
+  // Their colours in rows of IslandLanes (a row: kLanes contacts of one colour), same index; where
   // each colour's rows start (the serial group has none).
   std::vector<IslandLanes::Rows> colourRows_;
   std::vector<std::vector<uint32_t>> colourRowStart_;

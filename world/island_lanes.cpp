@@ -144,15 +144,6 @@ void IslandLanes::Rows::writeBack(uint32_t r, const uint32_t* slots, std::span<S
   }
 }
 
-void IslandLanes::Rows::carry(uint32_t from, Rows& other, uint32_t to) const {
-  const Row& src = rows_[from / kLanes];
-  Row& dst = other.rows_[to / kLanes];
-  const uint32_t f = from % kLanes, t = to % kLanes;
-  for (int d = 0; d < 3; ++d) dst.lambda[d][t] = src.lambda[d][f];
-  if ((src.rolls >> f) & 1)
-    for (int d = 0; d < 2; ++d) other.roll_[to / kLanes].lambdaR[d][t] = roll_[from / kLanes].lambdaR[d][f];
-}
-
 void IslandLanes::fillAll(Rows& rows, std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
                           std::span<const SolverContactExtras> extras, bool relax) {
   const uint32_t count = uint32_t(slots.size() / kLanes);
@@ -166,7 +157,7 @@ void IslandLanes::writeBackAll(const Rows& rows, std::span<const uint32_t> slots
 }
 
 uint32_t IslandLanes::levelRows(std::span<const uint32_t> order, std::span<const SolverContact> contacts,
-                                std::span<const SolverBody> bodies, std::vector<uint32_t>& out, std::vector<uint32_t>& at) {
+                                std::span<const SolverBody> bodies) {
   const uint32_t n = uint32_t(order.size());
   if (bodyLevel_.size() < bodies.size()) bodyLevel_.resize(bodies.size(), 0);
   levelOf_.resize(n);
@@ -191,13 +182,8 @@ uint32_t IslandLanes::levelRows(std::span<const uint32_t> order, std::span<const
     levelStart_[level + 1] = levelStart_[level] + (size + kLanes - 1) / kLanes * kLanes;  // slots, row aligned
     rows += (size + kLanes - 1) / kLanes;
   }
-  out.assign(size_t(rows) * kLanes, kNone);
-  at.resize(n);
-  for (uint32_t i = 0; i < n; ++i) {
-    const uint32_t slot = levelStart_[levelOf_[i]]++;
-    out[slot] = order[i];
-    at[i] = slot;
-  }
+  slots_.assign(size_t(rows) * kLanes, kNone);
+  for (uint32_t i = 0; i < n; ++i) slots_[levelStart_[levelOf_[i]]++] = order[i];
   return rows;
 }
 
@@ -215,6 +201,18 @@ void IslandLanes::Rows::pass(uint32_t first, uint32_t last, bool reversed, Solve
 }
 #endif
 
+#if defined(__SSE2__)
+// The rows in slots_ solved: laid out, the warm start, passes alternating direction (a reversed
+// pass runs the rows last to first: see the header), the impulses back to their contacts.
+void IslandLanes::runRows(uint32_t rows, std::span<SolverContact> contacts, std::span<SolverContactExtras> extras,
+                          std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations) {
+  fillAll(rows_, slots_, contacts, extras, relax);
+  if (warmStart) rows_.warmStart(0, rows, bodies.data());
+  for (int it = 0; it < iterations; ++it) rows_.pass(0, rows, (it & 1) != 0, bodies.data());
+  writeBackAll(rows_, slots_, contacts, extras);
+}
+#endif
+
 void IslandLanes::solve(std::span<const std::span<const uint32_t>> islands, std::span<SolverContact> contacts,
                         std::span<SolverContactExtras> extras, std::span<SolverBody> bodies, bool warmStart, bool relax,
                         int iterations) {
@@ -226,11 +224,7 @@ void IslandLanes::solve(std::span<const std::span<const uint32_t>> islands, std:
   slots_.assign(size_t(longest) * kLanes, kNone);
   for (uint32_t l = 0; l < uint32_t(islands.size()); ++l)
     for (uint32_t r = 0; r < uint32_t(islands[l].size()); ++r) slots_[size_t(r) * kLanes + l] = islands[l][r];
-  fillAll(forward_, slots_, contacts, extras, relax);
-  if (warmStart) forward_.warmStart(0, longest, bodies.data());
-  // Reversed passes run the rows from the longest island's end (see the header).
-  for (int it = 0; it < iterations; ++it) forward_.pass(0, longest, (it & 1) != 0, bodies.data());
-  writeBackAll(forward_, slots_, contacts, extras);
+  runRows(longest, contacts, extras, bodies, warmStart, relax, iterations);
 #else
   // One island after another, as ContactSolver solves an island alone.
   for (const std::span<const uint32_t>& island : islands) {
@@ -253,31 +247,9 @@ bool IslandLanes::solveOne(std::span<const uint32_t> island, std::span<SolverCon
 #if defined(__SSE2__)
   const uint32_t n = uint32_t(island.size());
   if (n == 0) return false;
-  const uint32_t forwardRows = levelRows(island, contacts, bodies, slots_, forwardAt_);
-  if (uint64_t(forwardRows) * kRowCostNum >= uint64_t(n) * kRowCostDen) return false;
-  reversedOrder_.assign(island.rbegin(), island.rend());
-  levelRows(reversedOrder_, contacts, bodies, backwardSlots_, backwardAt_);
-  // backwardAt_ by the island's own positions, as forwardAt_ is.
-  std::reverse(backwardAt_.begin(), backwardAt_.end());
-  fillAll(forward_, slots_, contacts, extras, relax);
-  fillAll(backward_, backwardSlots_, contacts, extras, relax);
-  const uint32_t backwardRows = uint32_t(backwardSlots_.size() / kLanes);
-  if (warmStart) forward_.warmStart(0, forwardRows, bodies.data());
-  bool inForward = true;  // which rows hold the impulses as they now are
-  for (int it = 0; it < iterations; ++it) {
-    const bool forwardPass = (it & 1) == 0;
-    if (forwardPass != inForward) {
-      for (uint32_t p = 0; p < n; ++p) {
-        if (forwardPass) backward_.carry(backwardAt_[p], forward_, forwardAt_[p]);
-        else forward_.carry(forwardAt_[p], backward_, backwardAt_[p]);
-      }
-      inForward = forwardPass;
-    }
-    if (forwardPass) forward_.pass(0, forwardRows, false, bodies.data());
-    else backward_.pass(0, backwardRows, false, bodies.data());
-  }
-  if (inForward) writeBackAll(forward_, slots_, contacts, extras);
-  else writeBackAll(backward_, backwardSlots_, contacts, extras);
+  const uint32_t rows = levelRows(island, contacts, bodies);
+  if (uint64_t(rows) * kMinContactsPerRow >= n) return false;
+  runRows(rows, contacts, extras, bodies, warmStart, relax, iterations);
   return true;
 #else
   (void)island, (void)contacts, (void)extras, (void)bodies, (void)warmStart, (void)relax, (void)iterations;

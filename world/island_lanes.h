@@ -29,8 +29,8 @@
 /// - solveOne(): one larger island (a pile), its contacts regrouped by level: a contact's level
 ///   is one more than the last level at which either of its dynamic bodies was updated, in the
 ///   pass's order, so contacts of one level share no dynamic body, and running the levels in
-///   order gives every body its updates in the pass's order. Each direction has its rows; the
-///   impulses follow a contact from one direction's rows to the other's between passes.
+///   order gives every body its updates in the pass's order; running the rows last to first
+///   gives every body its updates in reverse, as a reversed pass does.
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -61,15 +61,15 @@ class IslandLanes {
   void solve(std::span<const std::span<const uint32_t>> islands, std::span<SolverContact> contacts,
              std::span<SolverContactExtras> extras, std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations);
   /// solve() of one island whose contacts are regrouped by level (see above), when that fills
-  /// the lanes well enough to pay (see kRowCostNum); otherwise returns false having changed
+  /// the lanes well enough to pay (kMinContactsPerRow); otherwise returns false having changed
   /// nothing (solve it alone).
   bool solveOne(std::span<const uint32_t> island, std::span<SolverContact> contacts, std::span<SolverContactExtras> extras,
                 std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations);
-  /// Lanes are used where rows hold at least kRowCostNum / kRowCostDen contacts on average (an
-  /// island regrouped, or islands side by side): a row costs more than one contact's update
-  /// alone. monument's island stage, one thread, six runs: 56-74 us a frame at 1.5 contacts a
-  /// row, 50-64 at 3, 60-79 at 1; city_rain and ship_refit the same at 1.5 and 3.
-  static constexpr uint32_t kRowCostNum = 3, kRowCostDen = 1;
+  /// Lanes are used where rows hold at least this many contacts on average (an island
+  /// regrouped, or islands side by side): a row costs more than one contact's update alone.
+  /// monument's island stage, one thread, six runs: 56-74 us a frame at 1.5 contacts a row,
+  /// 50-64 at 3, 60-79 at 1; city_rain and ship_refit the same at 1.5 and 3.
+  static constexpr uint32_t kMinContactsPerRow = 3;
 
   /// Rows of kLanes contacts that share no dynamic body, field by field (lane l of a row is one
   /// contact): what a pass reads and updates. An idle lane holds zeros and a static body, so its
@@ -90,9 +90,6 @@ class IslandLanes {
     /// updateContact (and resistRolling where a lane's contact rolls) on rows [first, last),
     /// forward or from last - 1 down.
     void pass(uint32_t first, uint32_t last, bool reversed, SolverBody* bodies);
-    /// Copies contact impulses between rows: lane `from` of `this` to lane `to` of `other`
-    /// (slots numbered row * kLanes + lane).
-    void carry(uint32_t from, Rows& other, uint32_t to) const;
 
    private:
     using Row = lanes::Row;
@@ -105,18 +102,19 @@ class IslandLanes {
   static constexpr uint32_t kIdleBody = lanes::kIdleBody;
 
  private:
-  // The rows of `order`'s contacts by level into out (kLanes slots a row); at[i]: contact
-  // order[i]'s slot. Returns the row count.
-  uint32_t levelRows(std::span<const uint32_t> order, std::span<const SolverContact> contacts, std::span<const SolverBody> bodies,
-                     std::vector<uint32_t>& out, std::vector<uint32_t>& at);
+  // The rows of `order`'s contacts by level into slots_ (kLanes slots a row). Returns the row count.
+  uint32_t levelRows(std::span<const uint32_t> order, std::span<const SolverContact> contacts, std::span<const SolverBody> bodies);
   // Rows laid out from slots (kLanes a row) into rows.
   static void fillAll(Rows& rows, std::span<const uint32_t> slots, std::span<const SolverContact> contacts,
                       std::span<const SolverContactExtras> extras, bool relax);
   static void writeBackAll(const Rows& rows, std::span<const uint32_t> slots, std::span<SolverContact> contacts,
                            std::span<SolverContactExtras> extras);
+  // The rows of slots_ solved from laying out to writing back (what solve and solveOne share).
+  void runRows(uint32_t rows, std::span<SolverContact> contacts, std::span<SolverContactExtras> extras,
+               std::span<SolverBody> bodies, bool warmStart, bool relax, int iterations);
 
-  Rows forward_, backward_;
-  std::vector<uint32_t> slots_, backwardSlots_, forwardAt_, backwardAt_, reversedOrder_;
+  Rows rows_;
+  std::vector<uint32_t> slots_;  // the rows' contacts, kLanes a row (kNone: an idle lane)
   std::vector<uint32_t> bodyLevel_, levelOf_, levelStart_;  // levelRows() scratch (bodyLevel_: 0 between calls)
 };
 

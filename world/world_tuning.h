@@ -120,8 +120,8 @@ inline constexpr double kShockHeightEpsilon = 1e-3;
 /// thread; smaller ones are solved whole, one island per job.
 inline constexpr uint32_t kSplitContacts = 512;
 /// Islands of at least this many contacts are first offered to IslandLanes::solveOne (regrouped
-/// by level, the lanes of one register on one island); smaller ones share the lanes four
-/// islands at a time.
+/// by level, the lanes of one register on one island); smaller ones share the lanes with other
+/// islands (IslandLanes::kLanes at a time).
 inline constexpr uint32_t kLaneRegroupContacts = 16;
 /// Colours per split island (one bit each in a 64-bit mask); contacts left over form a last,
 /// serial group.
