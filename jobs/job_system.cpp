@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
+#include <exception>
 #include <mutex>
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
+#include <oneapi/tbb/task_group.h>
 #include <string>
 #include <thread>
 #include <vector>
@@ -57,6 +59,24 @@ struct JobSystem::Impl {
     if (++finished == workers.size() + 1) done.notify_all();
   }
   void run(const std::function<void()>& f) { f(); }
+  // note: a thread each, so TSan sees the beside job run concurrently with the caller's.
+  void beside(std::function<void()> f) {
+    besides.emplace_back([this, f = std::move(f)] {
+      try {
+        f();
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(m);
+        if (!besideError) besideError = std::current_exception();
+      }
+    });
+  }
+  void joinBeside() {
+    for (std::thread& t : besides) t.join();
+    besides.clear();
+    std::exception_ptr error;
+    std::swap(error, besideError);
+    if (error) std::rethrow_exception(error);
+  }
   void parallel(uint32_t chunks, const std::function<void(uint32_t)>& body) {
     {
       std::lock_guard<std::mutex> lock(m);
@@ -73,6 +93,8 @@ struct JobSystem::Impl {
   }
 
   std::vector<std::thread> workers;
+  std::vector<std::thread> besides;
+  std::exception_ptr besideError;
   std::mutex m;
   std::condition_variable wake, done;
   uint64_t generation = 0;
@@ -92,7 +114,32 @@ struct JobSystem::Impl {
       : control(tbb::global_control::max_allowed_parallelism, size_t(threads)), arena(threads) {}
   tbb::global_control control;
   tbb::task_arena arena;
+  tbb::task_group besides;
+  std::mutex errorLock;
+  std::exception_ptr besideError;  // the first beside job's exception, for joinBeside
   void run(const std::function<void()>& f) { arena.execute(f); }
+  // note: spawned inside the arena, so one of its workers steals it while the caller, back
+  // outside, goes on; waited for inside it (oneTBB's pattern for a task_group and an arena).
+  // note: each job catches its own exception, so one that throws does not cancel the others
+  // (as a task_group's would).
+  void beside(std::function<void()> f) {
+    arena.execute([&] {
+      besides.run([this, f = std::move(f)] {
+        try {
+          f();
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(errorLock);
+          if (!besideError) besideError = std::current_exception();
+        }
+      });
+    });
+  }
+  void joinBeside() {
+    arena.execute([&] { besides.wait(); });
+    std::exception_ptr error;
+    std::swap(error, besideError);
+    if (error) std::rethrow_exception(error);
+  }
   void parallel(uint32_t chunks, const std::function<void(uint32_t)>& body) {
     // note: iterate over chunk numbers, not items, so chunk boundaries are fixed whatever the
     // partitioner does; the partitioner only decides which thread runs which chunks.
@@ -114,7 +161,14 @@ JobSystem::JobSystem(int threads) : threads_(threads) {
   impl_ = std::make_unique<Impl>(threads);
 }
 
-JobSystem::~JobSystem() = default;
+JobSystem::~JobSystem() {
+  // note: a beside job still running would outlive what it reads; its exception is dropped here
+  // (a destructor must not throw).
+  try {
+    joinBeside();
+  } catch (...) {
+  }
+}
 
 void JobSystem::parallelFor(uint32_t begin, uint32_t end, uint32_t grain,
                             const std::function<void(uint32_t, uint32_t)>& body) {
@@ -200,5 +254,27 @@ void JobSystem::parallelWaves(const std::vector<uint32_t>& chunksOf, const std::
 }
 
 void JobSystem::run(const std::function<void()>& f) { impl_->run(f); }
+
+void JobSystem::runBeside(std::function<void()> f) {
+  if (threads_ > 1) {
+    impl_->beside(std::move(f));
+    return;
+  }
+  try {
+    f();
+  } catch (...) {
+    if (!besideError_) besideError_ = std::current_exception();
+  }
+}
+
+void JobSystem::joinBeside() {
+  if (threads_ > 1) {
+    impl_->joinBeside();
+    return;
+  }
+  std::exception_ptr error;
+  std::swap(error, besideError_);
+  if (error) std::rethrow_exception(error);
+}
 
 }  // namespace bw

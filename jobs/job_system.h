@@ -14,6 +14,7 @@
 /// oneTBB's process-wide parallelism limit while it lives, so keep one JobSystem per process
 /// (or nest only equal thread counts): TBB applies the smallest limit of all live ones.
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -52,10 +53,20 @@ class JobSystem {
   /// Runs f inside this system's arena (so nested TBB algorithms use its thread count).
   void run(const std::function<void()>& f);
 
+  /// Starts f beside what the controlling thread does next: a worker takes it while the caller
+  /// goes on (work that needs no one to wait for it, kept off the frame's critical path: the
+  /// render thread's wake). joinBeside() returns once every f started so far has finished, and
+  /// rethrows the first exception one threw. With one thread f runs at once, on the caller (its
+  /// exception still waits for joinBeside); the TSan build's pool gives each f a thread of its
+  /// own. f must not call this JobSystem. The destructor joins (dropping an exception).
+  void runBeside(std::function<void()> f);
+  void joinBeside();
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   int threads_;
+  std::exception_ptr besideError_;  // one thread: the first beside job's exception, for joinBeside
 };
 
 }  // namespace bw

@@ -56,6 +56,10 @@ void Profiler::recordInFrame(const char* name, int64_t beginNs, int64_t endNs, i
   append(bufferForThisThread(), {name, beginNs, endNs, 0, stage, frame, false});
 }
 
+void Profiler::recordBeside(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, uint32_t frame) {
+  append(bufferForThisThread(), {name, beginNs, endNs, 0, stage, frame, false, true});
+}
+
 void Profiler::append(ThreadBuffer& b, ProfileEvent e) {
   if (b.frameStarts.empty() || b.frameStarts.back().first != e.frame) {
     if (!b.frameStarts.empty() && b.frameStarts.back().first > e.frame) b.framesAscending = false;
@@ -89,7 +93,7 @@ void Profiler::clear() {
 double WorkSpan::boundMs(int threads) const {
   double t = 0;
   for (size_t s = 0; s < stageWorkMs.size(); ++s) t += std::max(stageWorkMs[s] / threads, stageSpanMs[s]);
-  return t;
+  return std::max({t, workMs / threads, besideSpanMs});
 }
 
 double WorkSpan::speedupBound(int threads) const {
@@ -107,6 +111,12 @@ namespace {
 class StageSums {
  public:
   void add(const ProfileEvent& e) {
+    if (e.beside) {
+      const double ms = double(e.endNs - e.beginNs) * 1e-6;
+      besideWork_ += ms;
+      besideLongest_ = std::max(besideLongest_, ms);
+      return;
+    }
     if (stages_.empty() || stages_[last_].stage != e.stage) last_ = slot(e.stage);
     StageTime& s = stages_[last_];
     const double ms = double(e.endNs - e.beginNs) * 1e-6;
@@ -136,6 +146,10 @@ class StageSums {
       ws.stageIds[k] = s.stage;
     }
     ws.stages = int(n);
+    ws.besideWorkMs = besideWork_;
+    ws.besideSpanMs = besideLongest_;
+    ws.workMs += besideWork_;
+    ws.spanMs = std::max(ws.spanMs, besideLongest_);
     startOver();
     return ws;
   }
@@ -149,6 +163,8 @@ class StageSums {
       t.spanMs += std::max(s.longest, s.serial);
     }
     t.stages = stages_.size();
+    t.workMs += besideWork_;
+    t.spanMs = std::max(t.spanMs, besideLongest_);
     startOver();
     return t;
   }
@@ -159,6 +175,7 @@ class StageSums {
     for (const StageTime& s : stages_) index_[s.bucket] = kEmpty;
     stages_.clear();
     last_ = 0;
+    besideWork_ = besideLongest_ = 0;
   }
   uint32_t slot(int32_t stage) {
     if (index_.empty()) index_.assign(256, kEmpty);
@@ -195,6 +212,7 @@ class StageSums {
   std::vector<uint32_t> index_;    // open addressing: stages_ slot, or kEmpty
   std::vector<uint64_t> keys_;
   uint32_t last_ = 0;
+  double besideWork_ = 0, besideLongest_ = 0;  // ms: the beside zones (outside the stages)
 };
 
 // Calls done(sums) after adding each frame 0 .. frames-1's job zones to one StageSums. The zones
@@ -268,13 +286,15 @@ WorkSpan Profiler::workSpan(uint32_t frame) const {
 void Profiler::writeChromeTrace(const std::string& path) const {
   nlohmann::json trace = nlohmann::json::array();
   for (const ProfileEvent& e : events()) {
+    nlohmann::json args{{"frame", e.frame}, {"stage", e.stage}};
+    if (e.beside) args["beside"] = true;
     trace.push_back({{"name", e.name},
                      {"ph", "X"},
                      {"ts", double(e.beginNs) * 1e-3},
                      {"dur", double(e.endNs - e.beginNs) * 1e-3},
                      {"pid", 1},
                      {"tid", e.thread},
-                     {"args", {{"frame", e.frame}, {"stage", e.stage}}}});
+                     {"args", std::move(args)}});
   }
   std::ofstream out(path);
   if (!out) throw std::runtime_error("Profiler::writeChromeTrace: cannot open '" + path + "' for writing");

@@ -32,6 +32,7 @@ struct ProfileEvent {
   int32_t stage;        ///< frame stage, or -1 for zones outside the stage structure
   uint32_t frame;
   bool serial = false;  ///< runs under a lock shared by every thread (see WorkSpan)
+  bool beside = false;  ///< runs beside the frame's stages, no stage waiting for it (see WorkSpan)
 };
 
 /// Work and span of one frame, from its job zones (those with stage >= 0).
@@ -41,11 +42,17 @@ struct ProfileEvent {
 /// Serial zones (work done under one lock every thread takes, like a mutex command queue's
 /// pushes) cannot overlap each other however many threads run, so a stage's span is at least
 /// the sum of its serial zones.
+/// Beside zones (JobSystem::runBeside: a job a worker runs while the stages go on, which no
+/// stage waits for, like the render thread's wake) are outside the stages' chain: they add to
+/// the work, and the frame takes at least their longest with p threads, not their sum.
 struct WorkSpan {
-  double workMs = 0;           ///< sum of all job durations
-  double spanMs = 0;           ///< sum over stages of the longest job
+  double workMs = 0;           ///< sum of all job durations, beside zones included
+  double spanMs = 0;           ///< sum over stages of the longest job (or the longest beside zone)
+  double besideWorkMs = 0, besideSpanMs = 0;  ///< the beside zones' sum and longest
   int stages = 0;
-  double boundMs(int threads) const;       ///< lower bound on the frame time with p threads
+  /// Lower bound on the frame time with p threads: the stages' chain, each stage
+  /// max(work / p, longest job), or all the work over p, or the longest beside zone.
+  double boundMs(int threads) const;
   double speedupBound(int threads) const;  ///< workMs / boundMs(p)
   std::vector<double> stageWorkMs, stageSpanMs;
   std::vector<int32_t> stageIds;  ///< the stage id of each entry above, ascending
@@ -81,6 +88,9 @@ class Profiler {
   /// The same for a thread that runs beside the frames (a render thread): the zone belongs to
   /// `frame` as given, since frame() is the controlling thread's and not safe to read here.
   void recordInFrame(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, uint32_t frame);
+  /// A beside zone (see WorkSpan) of `frame`, from any thread (a worker runs it while the
+  /// controlling thread has gone on, maybe to the next frame).
+  void recordBeside(const char* name, int64_t beginNs, int64_t endNs, int32_t stage, uint32_t frame);
 
   /// All recorded events, sorted by (begin, thread, end).
   std::vector<ProfileEvent> events() const;

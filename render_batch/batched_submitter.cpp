@@ -25,7 +25,7 @@ void BatchedSubmitter::growCurrent(uint32_t primitiveCapacity, uint32_t lightCap
   current_->lights.growCapacity(lightCapacity);
 }
 
-void BatchedSubmitter::commitFrame(uint64_t frame) {
+void BatchedSubmitter::commitFrame(uint64_t frame, bool wakeNow) {
   TransformBatch& batch = *current_;
   if (batch.frame != frame)
     throw InvalidInput("BatchedSubmitter::commitFrame: frame " + std::to_string(frame) + " was not begun (current " +
@@ -38,7 +38,7 @@ void BatchedSubmitter::commitFrame(uint64_t frame) {
     render_.endFrame(frame);
     throw CapacityExceeded(message);
   }
-  render_.commitBatch(batch, frame);
+  render_.commitBatch(batch, frame, wakeNow);
 }
 
 }  // namespace bw

@@ -37,8 +37,9 @@ class BatchedSubmitter final : public TransformUpdateSink {
   /// Raises the capacity of the batch begun to at least these counts (game thread, after
   /// beginFrame: the render thread is done with that batch). Allocates only when it grows.
   void growCurrent(uint32_t primitiveCapacity, uint32_t lightCapacity);
-  /// Commits frame's batch as one command (game thread, after the update joined).
-  void commitFrame(uint64_t frame);
+  /// Commits frame's batch as one command (game thread, after the update joined); wakeNow:
+  /// RenderThread::commitBatch (an overflowing frame's fence wakes at once).
+  void commitFrame(uint64_t frame, bool wakeNow = true);
 
  private:
   RenderThread& render_;

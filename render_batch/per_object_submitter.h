@@ -25,8 +25,8 @@ class PerObjectSubmitter final : public TransformUpdateSink {
     render_.enqueue(update);
     if (sendLightRadius_) render_.enqueue(LightRadiusUpdate{update.lightId});
   }
-  /// Closes the frame after the update joined (game thread).
-  void commitFrame(uint64_t frame) { render_.endFrame(frame); }
+  /// Closes the frame after the update joined (game thread); wakeNow: RenderThread::endFrame.
+  void commitFrame(uint64_t frame, bool wakeNow = true) { render_.endFrame(frame, wakeNow); }
 
  private:
   RenderThread& render_;

@@ -46,6 +46,7 @@ RenderFramePipeline::RenderFramePipeline(AttachmentStore& store, SubmissionMode 
 
 RenderFramePipeline::~RenderFramePipeline() {
   // note: the render thread may still read a batch; stop it before the submitter goes away.
+  wakeRenderThread();
   render_.reset();
 }
 
@@ -53,7 +54,7 @@ FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, JobSystem&
   return runFrame(bodies, [&jobs](TransformUpdate& update) { update.run(jobs); });
 }
 
-FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const UpdateRunner& runner) {
+FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const UpdateRunner& runner, bool wakeOwed) {
   FrameTiming timing;
   if (store_.lightCount() != sceneLights_)
     throw InvalidInput("RenderFramePipeline::runFrame: the store has " + std::to_string(store_.lightCount()) +
@@ -61,6 +62,7 @@ FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const Upda
                        " (lights cannot be added once the render thread runs)");
   const uint64_t frame = frame_ + 1;
   const auto waitStart = std::chrono::steady_clock::now();
+  wakeRenderThread();  // the last frame's, if its caller has not delivered it yet
   if (frame >= 3) render_->waitForFrame(frame - 2);
   timing.waitMs = msSince(waitStart);
   const auto start = std::chrono::steady_clock::now();
@@ -88,20 +90,23 @@ FrameTiming RenderFramePipeline::runFrame(const BodyPoseView& bodies, const Upda
     runner(update);
     frame_ = frame;
     CommitTimer commit{timing};
-    batched_->commitFrame(frame);
+    wakeOwed_.store(wakeOwed, std::memory_order_release);
+    batched_->commitFrame(frame, !wakeOwed);
   } else {
     TransformUpdate update(store_, bodies, *perObject_);
     growScene();
     runner(update);
     frame_ = frame;
     CommitTimer commit{timing};
-    perObject_->commitFrame(frame);
+    wakeOwed_.store(wakeOwed, std::memory_order_release);
+    perObject_->commitFrame(frame, !wakeOwed);
   }
   timing.gameMs = msSince(start);
   return timing;
 }
 
 void RenderFramePipeline::finish() {
+  wakeRenderThread();
   if (frame_ != 0) render_->waitForFrame(frame_);
 }
 

@@ -11,6 +11,12 @@
 /// off) grows the render scene first (a GrowScene ahead of the frame's records) and, when the
 /// batch capacity follows the store (UINT32_MAX), the frame's batch. Lights are registered once:
 /// a store that gained lights is refused (InvalidInput), nothing submitted.
+/// Waking: by default the commit wakes the render thread. A caller that has a worker to spare
+/// asks runFrame to leave the wake owed and delivers it with wakeRenderThread() from that worker
+/// beside its next frame (World does): the game thread then never pays the wake's syscall. An
+/// owed wake is delivered anyway before anything waits on the render thread (the next frame,
+/// finish(), the destructor), so a caller that forgets costs latency, never a hang.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -46,8 +52,13 @@ class RenderFramePipeline {
 
   /// Runs the next frame with the update on jobs.
   FrameTiming runFrame(const BodyPoseView& bodies, JobSystem& jobs);
-  /// Runs the next frame with the update run by runner.
-  FrameTiming runFrame(const BodyPoseView& bodies, const UpdateRunner& runner);
+  /// Runs the next frame with the update run by runner; wakeOwed: the commit leaves the render
+  /// thread's wake to wakeRenderThread() (see file comment).
+  FrameTiming runFrame(const BodyPoseView& bodies, const UpdateRunner& runner, bool wakeOwed = false);
+  /// Delivers an owed wake (nothing when none is owed); safe from any thread.
+  void wakeRenderThread() {
+    if (wakeOwed_.exchange(false, std::memory_order_acq_rel)) render_->wake();
+  }
   /// Waits until every submitted frame is applied.
   void finish();
 
@@ -68,6 +79,7 @@ class RenderFramePipeline {
   uint32_t scenePrimitives_;     // proxies the render scene has (or will have, after its queue)
   uint32_t sceneLights_;         // lights registered with the render scene
   bool batchFollowsStore_[2];    // primitive, light capacity given as UINT32_MAX
+  std::atomic<bool> wakeOwed_{false};  // a commit left its wake to wakeRenderThread()
 };
 
 }  // namespace bw

@@ -23,14 +23,14 @@ void RenderThread::wake() {
   wake_.value.notify_one();
 }
 
-void RenderThread::endFrame(uint64_t frame) {
+void RenderThread::endFrame(uint64_t frame, bool wakeNow) {
   queue_->push(FrameEnd{frame});
-  wake();
+  if (wakeNow) wake();
 }
 
-void RenderThread::commitBatch(const TransformBatch& batch, uint64_t frame) {
+void RenderThread::commitBatch(const TransformBatch& batch, uint64_t frame, bool wakeNow) {
   queue_->push(BatchCommit{&batch, frame});
-  wake();
+  if (wakeNow) wake();
 }
 
 void RenderThread::waitForFrame(uint64_t frame) {

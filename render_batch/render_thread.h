@@ -53,9 +53,13 @@ class RenderThread {
   /// Enqueues one command; safe from any thread.
   void enqueue(const RenderCommand& command) { queue_->push(command); }
   /// Closes frame (game thread, after all of the frame's commands were enqueued).
-  void endFrame(uint64_t frame);
+  /// wakeNow false leaves the wake to a wake() that must follow (the caller's job beside the
+  /// next frame: a wake is a futex syscall, 2-20 us on a VM whose other core sleeps).
+  void endFrame(uint64_t frame, bool wakeNow = true);
   /// Hands a whole batch over as one command that applies it and closes frame (game thread).
-  void commitBatch(const TransformBatch& batch, uint64_t frame);
+  void commitBatch(const TransformBatch& batch, uint64_t frame, bool wakeNow = true);
+  /// Wakes the render thread for what was enqueued; safe from any thread, and harmless twice.
+  void wake();
   /// Blocks until frame's fence was reached; rethrows a render-thread error.
   void waitForFrame(uint64_t frame);
   /// Last frame whose fence was reached.
@@ -71,7 +75,6 @@ class RenderThread {
 
  private:
   void loop();
-  void wake();
   bool execute(const RenderCommand& command);  // false on StopRenderThread
   void publishFence(uint64_t frame);
 

@@ -20,6 +20,10 @@
 /// l the update at stage + 1 + 2l and the submission at stage + 2 + 2l (serial zones with the
 /// mutex queue: its pushes hold one lock, so work/span counts them all in the span), the commit
 /// at stage + 1 + 2 * kMaxAttachmentDepth.
+/// The commit's wake: the render thread's wake (a futex syscall) is handed to a worker beside the
+/// next frame (JobSystem::runBeside; a beside zone "render wake" at the commit's stage, outside
+/// the frame's chain of stages), joined at the next run, finish() and destruction. The game
+/// thread's commit is the batch's hand-over and the job's.
 /// Growth: the world edits the store between runs (render chunks of edited cells resized, hidden,
 /// added or rebound; parts split off given theirs), and bodies may be added (parts, slabs): the
 /// next run looks at the new bodies from their current poses, lays its update chunks out again
@@ -73,7 +77,8 @@ inline double predictedRenderMs(const WorkSpan& frame, int renderStage, int thre
 struct RenderStageStats {
   double updateMs = 0;       ///< finding moved bodies + composing attachment poses and records
   double submissionMs = 0;   ///< handing records over (queue pushes or batch appends)
-  double commitMs = 0;       ///< closing the frame: one batch command, or the fence after per-object commands
+  double commitMs = 0;       ///< closing the frame: one batch command, or the fence after per-object commands, and the
+                             ///< wake's hand-over to a worker (the wake itself with one thread)
   double waitMs = 0;         ///< blocked until the render thread applied frame N-2
   double renderBusyMs = 0;   ///< render-thread busy time reported since the previous frame (lags by up to two frames)
   uint32_t movedBodies = 0;  ///< bodies whose pose changed
@@ -94,8 +99,11 @@ class WorldRender {
   RenderStageStats run(const BodyStore& bodies, const SleepState& sleep, JobSystem& jobs, Profiler& profiler, int stage);
   /// The next run looks at every body, static and sleeping ones too (after poses were set).
   void checkAllBodies() { checkAll_ = true; }
-  /// Waits until every submitted frame is applied.
-  void finish() { pipeline_->finish(); }
+  /// Waits for the last run's wake job (see file comment).
+  ~WorldRender();
+
+  /// Waits for the last run's wake job, then until every submitted frame is applied.
+  void finish();
   /// The render scene: call finish() first.
   const RenderScene& scene() const { return pipeline_->renderThread().scene(); }
   /// Render-thread counters as of the last fence reached.
@@ -115,6 +123,8 @@ class WorldRender {
   void growBodies(const BodyStore& bodies);
   // One timing slot per update chunk of every level, for the store as it is now.
   void layOutUpdateChunks();
+  // Waits for the wake job the last run handed to its JobSystem (beside the next frame).
+  void joinWake();
 
   AttachmentStore store_;
   std::unique_ptr<RenderFramePipeline> pipeline_;
@@ -131,6 +141,7 @@ class WorldRender {
   uint32_t laidOutFor_ = UINT32_MAX;          // store size the chunk layout was made for
   bool checkAll_ = true;
   uint64_t reportedBusyNs_ = 0;
+  JobSystem* wakeJobs_ = nullptr;  // where the last run's wake job went (outlives this: World's)
 };
 
 }  // namespace bw

@@ -36,6 +36,12 @@ double RenderFigures::predictedMs(int threads, bool withUpdate) const {
   return spans.empty() ? 0 : total / double(spans.size());
 }
 
+double RenderFigures::wakeBesideMs() const {
+  double total = 0;
+  for (const WorkSpan& ws : spans) total += ws.besideWorkMs;
+  return spans.empty() ? 0 : total / double(spans.size());
+}
+
 nlohmann::json RenderFigures::json(const World& world) const {
   const WorldRender& r = *world.render();
   nlohmann::json j{{"submission", submissionModeName(r.mode())},
@@ -49,6 +55,7 @@ nlohmann::json RenderFigures::json(const World& world) const {
                    {"submission_stage", submission.json()},
                    {"commit", commit.json()},
                    {"wait_for_render_thread", wait.json()},
+                   {"render_wake_beside_ms_per_frame", wakeBesideMs()},
                    {"game_thread_submission_commit_ms_per_frame", (submission.sum() + commit.sum()) / frames},
                    {"render_thread_busy_ms_per_frame", renderBusyMs / frames},
                    {"render_scene_hash", sceneHash}};
@@ -74,8 +81,8 @@ void RenderFigures::print(const World& world) const {
                 "hidden; upkeep %.3f ms median, %.3f ms max a frame (in transform)\n",
                 double(cellsRefreshed) / frames, (unsigned long long)cellsRecomputed, (unsigned long long)chunksAdded,
                 (unsigned long long)chunksHidden, chunkUpkeep.quantile(0.5), chunkUpkeep.max());
-  std::printf("  render thread busy %.3f ms per frame; render scene hash %016llx\n", renderBusyMs / frames,
-              (unsigned long long)sceneHash);
+  std::printf("  render thread busy %.3f ms per frame; its wake %.3f ms per frame beside the next frame; render scene hash %016llx\n",
+              renderBusyMs / frames, wakeBesideMs(), (unsigned long long)sceneHash);
   std::printf("  submission + commit predicted at 1/2/4/8/16 threads: %.3f %.3f %.3f %.3f %.3f ms per frame\n", predictedMs(1),
               predictedMs(2), predictedMs(4), predictedMs(8), predictedMs(16));
 }

@@ -31,6 +31,9 @@ struct RenderFigures {
   /// per stage max(work / p, span), serial zones (the mutex queue's pushes) all in the span.
   /// The transform update too when withUpdate.
   double predictedMs(int threads, bool withUpdate = false) const;
+  /// The render thread's wake per frame, run beside the next frame by a worker (on the game
+  /// thread itself with one thread): ms per frame.
+  double wakeBesideMs() const;
   std::vector<WorkSpan> spans;  ///< per frame (set by finish)
   int renderStage = 0;
   SubmissionMode mode = SubmissionMode::Batched;  ///< set by finish

@@ -1,8 +1,11 @@
 // JobSystem: every item visited once, fixed chunking, bit-identical reductions per thread count.
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <gtest/gtest.h>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "collision/core/argument_checks.h"
@@ -90,6 +93,58 @@ TEST(JobSystem, EmptyRangesAndBadThreadCounts) {
   EXPECT_EQ(calls, 0);
   EXPECT_THROW(JobSystem(0), InvalidInput);
   EXPECT_THROW(JobSystem(-3), InvalidInput);
+}
+
+// Waits up to 10 s for flag (a beside job that never sees its caller go on fails, not hangs).
+bool awaitFlag(const std::atomic<bool>& flag) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!flag.load(std::memory_order_acquire))
+    if (std::chrono::steady_clock::now() > until) return false;
+  return true;
+}
+
+TEST(JobSystem, BesideJobsRunWhileTheCallerGoesOnAndJoinWaitsForThem) {
+  for (int threads : {2, 4, 16}) {
+    JobSystem jobs(threads);
+    for (int round = 0; round < 20; ++round) {
+      // The job waits for what the caller does after runBeside returned, and the caller for
+      // what the job does before it ends: run on the caller, either would wait forever.
+      std::atomic<bool> callerWentOn{false}, jobStarted{false}, sawCaller{false};
+      std::atomic<int> finished{0};
+      jobs.runBeside([&] {
+        jobStarted.store(true, std::memory_order_release);
+        sawCaller.store(awaitFlag(callerWentOn), std::memory_order_relaxed);
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+        finished.fetch_add(1, std::memory_order_release);
+      });
+      callerWentOn.store(true, std::memory_order_release);
+      ASSERT_TRUE(awaitFlag(jobStarted)) << threads << " threads: the beside job never started";
+      // Parallel work goes on meanwhile, as a frame's stages do.
+      std::vector<uint32_t> hits(1000, 0);
+      jobs.parallelFor(0, 1000, 10, [&](uint32_t b, uint32_t e) {
+        for (uint32_t i = b; i < e; ++i) ++hits[i];
+      });
+      for (uint32_t h : hits) ASSERT_EQ(h, 1u);
+      jobs.joinBeside();
+      EXPECT_EQ(finished.load(std::memory_order_acquire), 1) << "joinBeside returned before its job finished";
+      EXPECT_TRUE(sawCaller.load()) << threads << " threads: the beside job ran on its caller";
+    }
+  }
+}
+
+TEST(JobSystem, BesideJobsWithOneThreadRunAtOnceAndTheirErrorsWaitForTheJoin) {
+  for (int threads : {1, 2}) {
+    JobSystem jobs(threads);
+    std::atomic<int> ran{0};
+    jobs.runBeside([&] { ran.fetch_add(1); });
+    if (threads == 1) EXPECT_EQ(ran.load(), 1) << "one thread: at once, on the caller";
+    jobs.runBeside([] { throw std::runtime_error("beside failed"); });
+    jobs.runBeside([&] { ran.fetch_add(1); });
+    EXPECT_THROW(jobs.joinBeside(), std::runtime_error) << threads << " threads";
+    EXPECT_EQ(ran.load(), 2) << "the other jobs ran";
+    EXPECT_NO_THROW(jobs.joinBeside()) << "an error is reported once";
+    jobs.runBeside([&] { ran.fetch_add(1); });  // left for the destructor to join
+  }
 }
 
 }  // namespace

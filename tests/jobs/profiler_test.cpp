@@ -49,6 +49,32 @@ TEST(Profiler, SerialZonesCountWholeInTheSpan) {
   EXPECT_EQ(ws.stageIds[1], 1);
 }
 
+TEST(Profiler, BesideZonesAddWorkButStayOffTheStagesChain) {
+  // Two stages of 4 x 1 ms and 1 x 1 ms, and a 3 ms beside job (the render wake of a frame).
+  const int64_t ms = 1'000'000;
+  Profiler p;
+  p.beginFrame(2);
+  for (int i = 0; i < 4; ++i) p.record("job", i * ms, (i + 1) * ms, 0);
+  p.record("tail", 4 * ms, 5 * ms, 1);
+  p.recordBeside("wake", 5 * ms, 8 * ms, 1, /*frame*/ 2);
+  p.recordBeside("other frame's", 0, 9 * ms, 1, /*frame*/ 3);
+  for (const WorkSpan& ws : {p.workSpan(2), p.workSpans(3)[2]}) {
+    EXPECT_EQ(ws.stages, 2) << "a beside zone is not a stage";
+    ASSERT_EQ(ws.stageWorkMs.size(), 2u);
+    EXPECT_DOUBLE_EQ(ws.stageWorkMs[1], 1.0) << "nor part of its stage";
+    EXPECT_DOUBLE_EQ(ws.workMs, 8.0);
+    EXPECT_DOUBLE_EQ(ws.besideWorkMs, 3.0);
+    EXPECT_DOUBLE_EQ(ws.besideSpanMs, 3.0);
+    EXPECT_DOUBLE_EQ(ws.spanMs, 3.0) << "the chain is 1 + 1 ms, the beside job 3";
+    EXPECT_DOUBLE_EQ(ws.boundMs(1), 8.0) << "all the work on one thread";
+    EXPECT_DOUBLE_EQ(ws.boundMs(2), 4.0) << "the work over two threads exceeds the chain (2 + 1 ms)";
+    EXPECT_DOUBLE_EQ(ws.boundMs(16), 3.0) << "the beside job is the longest path";
+  }
+  const WorkSpanTotals t = p.workSpanTotals(4);  // frames 0..3
+  EXPECT_DOUBLE_EQ(t.workMs, 8.0 + 9.0);
+  EXPECT_DOUBLE_EQ(t.spanMs, 3.0 + 9.0);
+}
+
 TEST(Profiler, OneFramesWorkSpanEqualsTheWholeRunPassInAnyFrameOrder) {
   // Frames recorded in ascending order (a world's, found by binary search) and a profiler that
   // went back to an earlier frame (scanned whole): workSpan(f) must equal workSpans()[f].

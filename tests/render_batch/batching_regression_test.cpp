@@ -169,6 +169,33 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{SubmissionMode::Batched, Runner::ThreadTeam4}),
     caseName);
 
+TEST(OwedWakes, FramesReachTheirFencesWhetherAWorkerWakesTheRenderThreadOrNoOne) {
+  // The world's way: the commit leaves the wake owed and a worker delivers it beside the next
+  // frame. In the first four frames and every third one after nobody delivers it: the next
+  // frame, or finish() for the last, must. A pipeline
+  // that dropped an owed wake would hang here (the render thread asleep, the game waiting).
+  const ReferenceRun& ref = reference();
+  for (SubmissionMode mode : {SubmissionMode::Batched, SubmissionMode::PerObjectMutex}) {
+    AttachmentWorkload w = makeWorkload();
+    std::vector<uint64_t> fenceHash(kFrames + 1, 0);
+    RenderFramePipeline pipeline(w.store, mode, [&fenceHash](uint64_t frame, const RenderScene& scene, const RenderThreadStats&) {
+      if (frame < fenceHash.size()) fenceHash[frame] = scene.stateHash();
+    });
+    JobSystem jobs(2);
+    for (uint64_t frame = 1; frame <= kFrames; ++frame) {
+      jobs.joinBeside();
+      applyInputs(w, frame);
+      pipeline.runFrame(w.bodies.view(), [&jobs](TransformUpdate& u) { u.run(jobs); }, /*wakeOwed*/ true);
+      if (frame > 4 && frame % 3 != 0) jobs.runBeside([&pipeline] { pipeline.wakeRenderThread(); });
+    }
+    jobs.joinBeside();
+    pipeline.finish();
+    EXPECT_TRUE(pipeline.renderThread().scene().identicalTo(*ref.finalScene)) << submissionModeName(mode);
+    for (uint64_t frame = 1; frame <= kFrames; ++frame)
+      EXPECT_EQ(fenceHash[frame], ref.hash[frame]) << submissionModeName(mode) << " frame " << frame;
+  }
+}
+
 TEST(FrameFence, GameNeverSeesTheNextFrameBeforeItCommits) {
   const ReferenceRun& ref = reference();
   AttachmentWorkload w = makeWorkload();
