@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
+#include <deque>
 #include <exception>
 #include <mutex>
 #include <oneapi/tbb/blocked_range.h>
@@ -40,6 +41,12 @@ struct JobSystem::Impl {
     }
     wake.notify_all();
     for (auto& w : workers) w.join();
+    {
+      std::lock_guard<std::mutex> lock(besideLock);
+      besideStop = true;
+    }
+    besideWake.notify_all();
+    if (besideThread.joinable()) besideThread.join();
   }
   void workerLoop() {
     uint64_t seen = 0;
@@ -59,20 +66,40 @@ struct JobSystem::Impl {
     if (++finished == workers.size() + 1) done.notify_all();
   }
   void run(const std::function<void()>& f) { f(); }
-  // note: a thread each, so TSan sees the beside job run concurrently with the caller's.
+  // note: beside jobs run on a thread of their own, so TSan sees them run concurrently with
+  // the caller's work (one thread for all: a world hands one over every frame).
   void beside(std::function<void()> f) {
-    besides.emplace_back([this, f = std::move(f)] {
+    {
+      std::lock_guard<std::mutex> lock(besideLock);
+      besideQueue.push_back(std::move(f));
+      ++besidePending;
+      if (!besideThread.joinable()) besideThread = std::thread([this] { besideLoop(); });
+    }
+    besideWake.notify_all();
+  }
+  void besideLoop() {
+    std::unique_lock<std::mutex> lock(besideLock);
+    for (;;) {
+      besideWake.wait(lock, [&] { return besideStop || !besideQueue.empty(); });
+      if (besideQueue.empty()) return;  // stopping, nothing left
+      std::function<void()> f = std::move(besideQueue.front());
+      besideQueue.pop_front();
+      lock.unlock();
+      std::exception_ptr error;
       try {
         f();
       } catch (...) {
-        std::lock_guard<std::mutex> lock(m);
-        if (!besideError) besideError = std::current_exception();
+        error = std::current_exception();
       }
-    });
+      lock.lock();
+      if (error && !besideError) besideError = error;
+      --besidePending;
+      besideWake.notify_all();
+    }
   }
   void joinBeside() {
-    for (std::thread& t : besides) t.join();
-    besides.clear();
+    std::unique_lock<std::mutex> lock(besideLock);
+    besideWake.wait(lock, [&] { return besidePending == 0; });
     std::exception_ptr error;
     std::swap(error, besideError);
     if (error) std::rethrow_exception(error);
@@ -93,9 +120,15 @@ struct JobSystem::Impl {
   }
 
   std::vector<std::thread> workers;
-  std::vector<std::thread> besides;
-  std::exception_ptr besideError;
   std::mutex m;
+  // beside jobs
+  std::thread besideThread;
+  std::mutex besideLock;
+  std::condition_variable besideWake;
+  std::deque<std::function<void()>> besideQueue;
+  size_t besidePending = 0;
+  bool besideStop = false;
+  std::exception_ptr besideError;
   std::condition_variable wake, done;
   uint64_t generation = 0;
   bool stop = false;

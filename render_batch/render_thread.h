@@ -54,7 +54,7 @@ class RenderThread {
   void enqueue(const RenderCommand& command) { queue_->push(command); }
   /// Closes frame (game thread, after all of the frame's commands were enqueued).
   /// wakeNow false leaves the wake to a wake() that must follow (the caller's job beside the
-  /// next frame: a wake is a futex syscall, 2-20 us on a VM whose other core sleeps).
+  /// next frame: a wake is a futex syscall, 6-22 us on this VM).
   void endFrame(uint64_t frame, bool wakeNow = true);
   /// Hands a whole batch over as one command that applies it and closes frame (game thread).
   void commitBatch(const TransformBatch& batch, uint64_t frame, bool wakeNow = true);

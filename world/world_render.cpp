@@ -170,7 +170,7 @@ RenderStageStats WorldRender::run(const BodyStore& bodies, const SleepState& sle
     store_.markAllDirty();
     throw;
   }
-  // The render thread's wake (a futex syscall: 2-20 us on this VM, the largest single job of
+  // The render thread's wake (a futex syscall: 6-22 us on this VM, the largest single job of
   // crates_on_grid's frame) goes to a worker beside the next frame; the game thread only hands
   // it over. With one thread it runs here, at once, as the commit's did.
   const bool profiling = profiler.enabled();
