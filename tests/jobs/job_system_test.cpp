@@ -137,7 +137,9 @@ TEST(JobSystem, BesideJobsWithOneThreadRunAtOnceAndTheirErrorsWaitForTheJoin) {
     JobSystem jobs(threads);
     std::atomic<int> ran{0};
     jobs.runBeside([&] { ran.fetch_add(1); });
-    if (threads == 1) EXPECT_EQ(ran.load(), 1) << "one thread: at once, on the caller";
+    if (threads == 1) {
+      EXPECT_EQ(ran.load(), 1) << "one thread: at once, on the caller";
+    }
     jobs.runBeside([] { throw std::runtime_error("beside failed"); });
     jobs.runBeside([&] { ran.fetch_add(1); });
     EXPECT_THROW(jobs.joinBeside(), std::runtime_error) << threads << " threads";
