@@ -134,18 +134,21 @@ TEST(JobSystem, BesideJobsRunWhileTheCallerGoesOnAndJoinWaitsForThem) {
 
 TEST(JobSystem, BesideJobsWithOneThreadRunAtOnceAndTheirErrorsWaitForTheJoin) {
   for (int threads : {1, 2}) {
-    JobSystem jobs(threads);
-    std::atomic<int> ran{0};
-    jobs.runBeside([&] { ran.fetch_add(1); });
-    if (threads == 1) {
-      EXPECT_EQ(ran.load(), 1) << "one thread: at once, on the caller";
+    std::atomic<int> ran{0};  // declared first: the destructor's join below still sees it
+    {
+      JobSystem jobs(threads);
+      jobs.runBeside([&] { ran.fetch_add(1); });
+      if (threads == 1) {
+        EXPECT_EQ(ran.load(), 1) << "one thread: at once, on the caller";
+      }
+      jobs.runBeside([] { throw std::runtime_error("beside failed"); });
+      jobs.runBeside([&] { ran.fetch_add(1); });
+      EXPECT_THROW(jobs.joinBeside(), std::runtime_error) << threads << " threads";
+      EXPECT_EQ(ran.load(), 2) << "the other jobs ran";
+      EXPECT_NO_THROW(jobs.joinBeside()) << "an error is reported once";
+      jobs.runBeside([&] { ran.fetch_add(1); });  // left for the destructor to join
     }
-    jobs.runBeside([] { throw std::runtime_error("beside failed"); });
-    jobs.runBeside([&] { ran.fetch_add(1); });
-    EXPECT_THROW(jobs.joinBeside(), std::runtime_error) << threads << " threads";
-    EXPECT_EQ(ran.load(), 2) << "the other jobs ran";
-    EXPECT_NO_THROW(jobs.joinBeside()) << "an error is reported once";
-    jobs.runBeside([&] { ran.fetch_add(1); });  // left for the destructor to join
+    EXPECT_EQ(ran.load(), 3) << "the destructor joined the last job";
   }
 }
 
