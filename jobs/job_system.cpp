@@ -85,14 +85,8 @@ struct JobSystem::Impl {
       std::function<void()> f = std::move(besideQueue.front());
       besideQueue.pop_front();
       lock.unlock();
-      std::exception_ptr error;
-      try {
-        f();
-      } catch (...) {
-        error = std::current_exception();
-      }
+      f();  // JobSystem::runBeside's wrapper catches
       lock.lock();
-      if (error && !besideError) besideError = error;
       --besidePending;
       besideWake.notify_all();
     }
@@ -100,9 +94,6 @@ struct JobSystem::Impl {
   void joinBeside() {
     std::unique_lock<std::mutex> lock(besideLock);
     besideWake.wait(lock, [&] { return besidePending == 0; });
-    std::exception_ptr error;
-    std::swap(error, besideError);
-    if (error) std::rethrow_exception(error);
   }
   void parallel(uint32_t chunks, const std::function<void(uint32_t)>& body) {
     {
@@ -128,7 +119,6 @@ struct JobSystem::Impl {
   std::deque<std::function<void()>> besideQueue;
   size_t besidePending = 0;
   bool besideStop = false;
-  std::exception_ptr besideError;
   std::condition_variable wake, done;
   uint64_t generation = 0;
   bool stop = false;
@@ -148,30 +138,15 @@ struct JobSystem::Impl {
   tbb::global_control control;
   tbb::task_arena arena;
   tbb::task_group besides;
-  std::mutex errorLock;
-  std::exception_ptr besideError;  // the first beside job's exception, for joinBeside
   void run(const std::function<void()>& f) { arena.execute(f); }
   // note: spawned inside the arena, so one of its workers steals it while the caller, back
   // outside, goes on; waited for inside it (oneTBB's pattern for a task_group and an arena).
-  // note: each job catches its own exception, so one that throws does not cancel the others
-  // (as a task_group's would).
+  // f never throws (JobSystem::runBeside's wrapper catches), so none cancels the others.
   void beside(std::function<void()> f) {
-    arena.execute([&] {
-      besides.run([this, f = std::move(f)] {
-        try {
-          f();
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(errorLock);
-          if (!besideError) besideError = std::current_exception();
-        }
-      });
-    });
+    arena.execute([&] { besides.run(std::move(f)); });
   }
   void joinBeside() {
     arena.execute([&] { besides.wait(); });
-    std::exception_ptr error;
-    std::swap(error, besideError);
-    if (error) std::rethrow_exception(error);
   }
   void parallel(uint32_t chunks, const std::function<void(uint32_t)>& body) {
     // note: iterate over chunk numbers, not items, so chunk boundaries are fixed whatever the
@@ -289,22 +264,24 @@ void JobSystem::parallelWaves(const std::vector<uint32_t>& chunksOf, const std::
 void JobSystem::run(const std::function<void()>& f) { impl_->run(f); }
 
 void JobSystem::runBeside(std::function<void()> f) {
+  // One wrapper for every backend: the first exception is kept for joinBeside.
+  auto job = [this, f = std::move(f)] {
+    try {
+      f();
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(besideErrorLock_);
+      if (!besideError_) besideError_ = std::current_exception();
+    }
+  };
   if (threads_ > 1) {
-    impl_->beside(std::move(f));
-    return;
-  }
-  try {
-    f();
-  } catch (...) {
-    if (!besideError_) besideError_ = std::current_exception();
+    impl_->beside(std::move(job));
+  } else {
+    job();
   }
 }
 
 void JobSystem::joinBeside() {
-  if (threads_ > 1) {
-    impl_->joinBeside();
-    return;
-  }
+  if (threads_ > 1) impl_->joinBeside();
   std::exception_ptr error;
   std::swap(error, besideError_);
   if (error) std::rethrow_exception(error);

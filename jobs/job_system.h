@@ -17,6 +17,7 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 namespace bw {
@@ -57,8 +58,8 @@ class JobSystem {
   /// goes on (work that needs no one to wait for it, kept off the frame's critical path: the
   /// render thread's wake). joinBeside() returns once every f started so far has finished, and
   /// rethrows the first exception one threw. With one thread f runs at once, on the caller (its
-  /// exception still waits for joinBeside); the TSan build's pool gives each f a thread of its
-  /// own. f must not call this JobSystem. The destructor joins (dropping an exception).
+  /// exception still waits for joinBeside); the TSan build's pool runs them on a thread of
+  /// their own. f must not call this JobSystem. The destructor joins (dropping an exception).
   void runBeside(std::function<void()> f);
   void joinBeside();
 
@@ -66,7 +67,8 @@ class JobSystem {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   int threads_;
-  std::exception_ptr besideError_;  // one thread: the first beside job's exception, for joinBeside
+  std::exception_ptr besideError_;  // the first beside job's exception, for joinBeside
+  std::mutex besideErrorLock_;                    // held by a beside job storing it
 };
 
 }  // namespace bw
