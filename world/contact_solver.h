@@ -67,11 +67,12 @@ class ContactSolver {
   void keepImpulses(JobSystem& jobs, Profiler& profiler, int stage);
 
  private:
-  /// Fewest pairs per job of prepare(): a contact costs ~100 ns, a pair up to manifoldSize of
-  /// them, so 16 pairs are several microseconds. 32 made crates_on_grid's ~365 pairs 11 jobs of
-  /// ~12 us (traced): the stage's span at 16 threads, and its work/span bound there 7.4-8.1x
-  /// against 7.6-8.1x at 16 (three runs each, session 39).
+  /// Fewest pairs per job of keepImpulses(): a pair's few contacts copied and sorted.
   static constexpr uint32_t kMinPrepareGrain = 16;
+  /// Fewest weight (pairs + contacts) per job of prepare(): a contact costs ~100 ns, so 32 are a
+  /// few microseconds; jobs of 32 pairs made crates_on_grid's ~365 pairs 11 jobs of ~12 us
+  /// (traced), the stage's span at 16 threads.
+  static constexpr uint32_t kMinPrepareWeight = 32;
   /// Fewest contacts per job of islands solved whole: one job per island made city_rain's ~280
   /// islands a frame ~280 jobs of ~1.6 us each (traced), a tenth of the stage's wall time in
   /// job overhead on one thread.
@@ -123,6 +124,7 @@ class ContactSolver {
   std::vector<CachedImpulse> cache_, nextCache_;
   std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
   std::vector<uint32_t> islandJobStart_;    // where each job's run of smallIslands_ starts (and the end)
+  std::vector<uint32_t> prepareJobStart_;   // prepare(): the first pair of each job (and the end)
   // The colourings of this substep's split islands, in solve order; valid for the relax pass
   // once the solve has made them (coloured_; prepare() resets it).
   std::vector<IslandColouring> colourings_;

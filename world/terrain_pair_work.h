@@ -52,6 +52,13 @@ struct TerrainPairWork {
   };
   std::vector<uint32_t> pairQueries;
   std::vector<SelectChunk> selectChunks;
+  /// finish's per-job counts of the groups it completed (all queries cached, buoyancy done),
+  /// and whether the job left a group for apply.
+  struct FinishChunk {
+    uint32_t contacts = 0, floating = 0;
+    bool applyLeft = false;
+  };
+  std::vector<FinishChunk> finishChunks;
   std::vector<uint8_t> bodyQueried;        // per body: has a query this substep (all 0 between)
   bool bodiesUnique = true;                // no body has two queries (then buoyancy runs per query in parallel)
 };

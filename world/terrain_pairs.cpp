@@ -10,10 +10,12 @@
 //   pieces (parallel, per piece): the contacts of a few candidate triangles each, so a body
 //          lying across many triangles is spread over several jobs;
 //   finish (parallel, per pair): each query's pieces' contacts joined in order, interior
-//          edges and repeated points dropped; buoyancy when no body has two terrain queries;
-//   apply  (one thread, pair order): a pair with a query that needed a chunk not yet meshed
-//          runs again in query order, that query the filling way (the meshes stay lazy: only chunks a body touches are ever built, and
-//          in steady state every chunk is cached); counters; buoyancy otherwise.
+//          edges and repeated points dropped; buoyancy when no body has two terrain queries,
+//          and then counters, per job, for the pairs whose queries were all cached;
+//   apply  (one thread, pair order): the jobs' counters summed; a pair with a query that
+//          needed a chunk not yet meshed runs again in query order, that query the filling way
+//          (the meshes stay lazy: only chunks a body touches are ever built, and in steady
+//          state every chunk is cached); counters and buoyancy for what finish left.
 // The contacts are the same whichever stage computes them (the pieces join in the serial
 // query's order), so the state is the same for any thread count and any cache budget.
 // note: the parallel reads do not refresh the cache's LRU order; a scene whose touched chunks
@@ -218,30 +220,52 @@ void World::terrainPairs(float dt) {
     finishTerrainContacts(out, start, faceNormals);
     markBrick(q, out, start);
   };
+  const auto allCached = [&](const TerrainPairWork::Group& group) {
+    for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i)
+      if (!w.queries[i].cached) return false;
+    return true;
+  };
+  // A finish job counts its groups' contacts and bodies in water when every query of a group
+  // was planned from cached chunks and buoyancy ran here: then apply only sums the jobs' counts
+  // and visits the jobs that hold a group to query again (monument: apply was a serial 1 us a
+  // substep over every group, a tenth of its span at 16 threads outside the raft island).
   const uint32_t groupCount = uint32_t(w.groups.size());
-  jobs_.parallelFor(0, groupCount, grainFor(groupCount, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
+  const uint32_t finishGrain = grainFor(groupCount, kMinTerrainGrain);
+  w.finishChunks.assign(JobSystem::chunkCount(0, groupCount, finishGrain), TerrainPairWork::FinishChunk{});
+  jobs_.parallelFor(0, groupCount, finishGrain, [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "terrain: finish", stage_ + kTerrainStage + 6);
     // note: thread_local scratch: the face normals of one query, joined from its pieces.
     thread_local std::vector<Vec3f> faceNormals;
+    TerrainPairWork::FinishChunk counts;
     for (uint32_t g = begin; g < end; ++g) {
       const TerrainPairWork::Group& group = w.groups[g];
       std::vector<Contact>& out = pairContacts_[group.pair];
       out.clear();
+      bool wet = false;
       for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) {
         join(i, out, faceNormals);
+        wet |= w.queries[i].wet;
         if (w.bodiesUnique && w.queries[i].wet) buoyancy(w.queries[i]);
       }
       if (group.queryCount > 1) reduceManifold(out, 0, scene_.settings.manifoldSize);  // a small grid's bricks: one manifold
+      if (!w.bodiesUnique || !allCached(group)) {
+        counts.applyLeft = true;
+        continue;
+      }
+      counts.contacts += uint32_t(out.size());
+      counts.floating += wet ? 1u : 0u;
     }
+    w.finishChunks[begin / finishGrain] = counts;
   });
   ProfileZone z(profiler_, "terrain: apply", stage_ + kTerrainStage + 7);
   std::vector<Vec3f>& faceNormals = w.faceNormals;
-  for (const TerrainPairWork::Group& group : w.groups) {
+  // A group its finish job did not count: queried again in query order when a query needed a
+  // chunk not yet meshed (the uncached ones filling the cache), then counted; buoyancy here
+  // when a body has two queries.
+  const auto applyGroup = [&](const TerrainPairWork::Group& group) {
+    if (w.bodiesUnique && allCached(group)) return;  // counted by its finish job
     std::vector<Contact>& out = pairContacts_[group.pair];
-    bool allCached = true;
-    for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) allCached &= w.queries[i].cached;
-    if (!allCached) {
-      // The group again in query order, the uncached queries filling the cache.
+    if (!allCached(group)) {
       out.clear();
       for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) {
         const TerrainPairWork::Query& q = w.queries[i];
@@ -264,6 +288,14 @@ void World::terrainPairs(float dt) {
       wet = true;
     }
     stats_.floating += wet ? 1u : 0u;
+  };
+  for (uint32_t chunk = 0; chunk < uint32_t(w.finishChunks.size()); ++chunk) {
+    const TerrainPairWork::FinishChunk& counts = w.finishChunks[chunk];
+    stats_.terrainContacts += counts.contacts;
+    stats_.floating += counts.floating;
+    if (!counts.applyLeft) continue;
+    for (uint32_t g = chunk * finishGrain; g < std::min(groupCount, (chunk + 1) * finishGrain); ++g)
+      applyGroup(w.groups[g]);
   }
 }
 

@@ -1,6 +1,7 @@
 // The world on real content and its tools: a Brickadia save as a static grid (and tiled), a
 // MagicaVoxel model as terrain with water, bad content files named in a scene, contact probes
 // that leave the state alone, grid edits between steps, and the ten-box stack's drift goal.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -93,6 +94,33 @@ TEST(WorldContent, CratesFloatAtTheLakeSurfaceAndDenseOnesSink) {
     EXPECT_NEAR(world.bodies().position[crate].z(), 3.0 + 0.4, 0.1) << "a dense crate rests on the lake floor";
     EXPECT_GT(world.lastStats().terrainContacts, 0u);
   }
+}
+
+// The step's terrain counters are summed per job of the parallel finish for pairs whose chunks
+// were cached, and on one thread for the rest (a first frame meshes every chunk it touches):
+// either way they equal a recount of the terrain pairs' contact lists (one substep a frame, so
+// the last substep's lists are the step's), and crates in the lake count as floating.
+TEST(WorldContent, TerrainCountersEqualARecountOfTheTerrainPairsContacts) {
+  SceneDescription scene = shipped("monument");
+  scene.settings.substeps = 1;
+  scene.settings.sleeping = false;
+  World world(scene, 2);
+  uint32_t mostFloating = 0, framesWithContacts = 0;
+  for (int f = 0; f < 90; ++f) {
+    world.step();
+    uint32_t recount = 0;
+    for (uint32_t k = 0; k < world.pairs().size(); ++k) {
+      const BodyPair& p = world.pairs()[k];
+      if (world.bodies().shape[p.a].isTerrain() || world.bodies().shape[p.b].isTerrain())
+        recount += uint32_t(world.pairContacts(k).size());
+    }
+    ASSERT_EQ(world.lastStats().terrainContacts, recount) << "frame " << f;
+    framesWithContacts += recount > 0 ? 1 : 0;
+    EXPECT_LE(world.lastStats().floating, world.bodies().size());
+    mostFloating = std::max(mostFloating, world.lastStats().floating);
+  }
+  EXPECT_GT(framesWithContacts, 45u);
+  EXPECT_GT(mostFloating, 0u);
 }
 
 TEST(WorldContent, ContactProbesLeaveTheStateUnchanged) {
