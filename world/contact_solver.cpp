@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 
 #include "world/contact_update.h"
 #include "world/world_tuning.h"
@@ -143,15 +144,10 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
   const uint64_t weight = uint64_t(first_[pairCount]) + pairCount;
   const uint32_t jobCount = uint32_t(std::clamp<uint64_t>(weight / kMinPrepareWeight, 1, tuning::kTargetJobs));
   prepareJobStart_.resize(jobCount + 1);
-  for (uint32_t j = 0; j <= jobCount; ++j) {
+  const auto pairIndices = std::views::iota(0u, pairCount);
+  for (uint32_t j = 0; j < jobCount; ++j) {  // job j starts at the first pair whose weight starts at or past its share
     const uint64_t at = weight * j / jobCount;
-    uint32_t lo = 0, hi = pairCount;  // the first pair whose weight starts at or past `at`
-    while (lo < hi) {
-      const uint32_t mid = (lo + hi) / 2;
-      if (uint64_t(first_[mid]) + mid < at) lo = mid + 1;
-      else hi = mid;
-    }
-    prepareJobStart_[j] = lo;
+    prepareJobStart_[j] = *std::ranges::partition_point(pairIndices, [&](uint32_t k) { return uint64_t(first_[k]) + k < at; });
   }
   prepareJobStart_[jobCount] = pairCount;
   jobs.parallelFor(0, jobCount, 1, [&](uint32_t jobBegin, uint32_t jobEnd) {

@@ -263,9 +263,10 @@ void World::terrainPairs(float dt) {
   // chunk not yet meshed (the uncached ones filling the cache), then counted; buoyancy here
   // when a body has two queries.
   const auto applyGroup = [&](const TerrainPairWork::Group& group) {
-    if (w.bodiesUnique && allCached(group)) return;  // counted by its finish job
+    const bool cached = allCached(group);
+    if (w.bodiesUnique && cached) return;  // counted by its finish job
     std::vector<Contact>& out = pairContacts_[group.pair];
-    if (!allCached(group)) {
+    if (!cached) {
       out.clear();
       for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) {
         const TerrainPairWork::Query& q = w.queries[i];
