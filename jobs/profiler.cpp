@@ -9,9 +9,47 @@
 
 namespace bw {
 
+namespace {
+
+// A thread's events in blocks of kBlock that never move: appending never copies what was
+// recorded. (A vector doubling as a run grows copied its whole log, tens of MB at a million
+// events, inside whichever gap between zones it fell: up to 0.9 ms read as serial glue.)
+class EventLog {
+ public:
+  static constexpr size_t kBlock = 16384;
+  size_t size() const { return size_; }
+  const ProfileEvent& operator[](size_t k) const { return blocks_[k / kBlock][k % kBlock]; }
+  void push_back(const ProfileEvent& e) {
+    if (size_ == blocks_.size() * kBlock) blocks_.push_back(std::make_unique<ProfileEvent[]>(kBlock));
+    blocks_[size_ / kBlock][size_ % kBlock] = e;
+    ++size_;
+  }
+  void clear() { size_ = 0; }  // the blocks stay, to be filled again
+  struct Iterator {
+    const EventLog* log;
+    size_t k;
+    const ProfileEvent* at;  // event k
+    const ProfileEvent& operator*() const { return *at; }
+    Iterator& operator++() {
+      ++k;
+      at = k % kBlock != 0 ? at + 1 : k < log->size_ ? log->blocks_[k / kBlock].get() : nullptr;
+      return *this;
+    }
+    bool operator!=(const Iterator& o) const { return k != o.k; }
+  };
+  Iterator begin() const { return {this, 0, size_ ? blocks_[0].get() : nullptr}; }
+  Iterator end() const { return {this, size_, nullptr}; }
+
+ private:
+  std::vector<std::unique_ptr<ProfileEvent[]>> blocks_;
+  size_t size_ = 0;
+};
+
+}  // namespace
+
 struct Profiler::ThreadBuffer {
   uint32_t thread;
-  std::vector<ProfileEvent> events;
+  EventLog events;
   // Where each run of one frame's events starts: {frame, first event}. Frames arrive in
   // ascending order from a world, so workSpan(frame) finds its events by binary search
   // (O(events of that frame)); a buffer that ever went back to an earlier frame is scanned whole.
@@ -43,7 +81,6 @@ Profiler::ThreadBuffer& Profiler::bufferForThisThread() {
   buffers_.push_back(std::make_unique<ThreadBuffer>());
   ThreadBuffer& b = *buffers_.back();
   b.thread = uint32_t(buffers_.size() - 1);
-  b.events.reserve(4096);
   tlsSlots.push_back({id_, &b});
   return b;
 }
@@ -72,7 +109,8 @@ void Profiler::append(ThreadBuffer& b, ProfileEvent e) {
 std::vector<ProfileEvent> Profiler::events() const {
   std::vector<ProfileEvent> all;
   std::lock_guard<std::mutex> lock(registry_);
-  for (const auto& b : buffers_) all.insert(all.end(), b->events.begin(), b->events.end());
+  for (const auto& b : buffers_)
+    for (const ProfileEvent& e : b->events) all.push_back(e);
   std::sort(all.begin(), all.end(), [](const ProfileEvent& a, const ProfileEvent& b) {
     if (a.beginNs != b.beginNs) return a.beginNs < b.beginNs;
     if (a.thread != b.thread) return a.thread < b.thread;
@@ -91,7 +129,7 @@ void Profiler::clear() {
 }
 
 double WorkSpan::boundMs(int threads) const {
-  double t = 0;
+  double t = glueMs;
   for (size_t s = 0; s < stageWorkMs.size(); ++s) t += std::max(stageWorkMs[s] / threads, stageSpanMs[s]);
   return std::max({t, workMs / threads, besideSpanMs});
 }
@@ -102,6 +140,47 @@ double WorkSpan::speedupBound(int threads) const {
 }
 
 namespace {
+
+// Glue (see WorkSpan) of frames [firstFrame, firstFrame + glue.size()) from each thread's events
+// in recording order: the gap before a staged zone whose stage differs from the previous staged
+// zone's of the same frame on this thread. A frame with staged zones from two threads has none.
+struct FrameGlue {
+  static constexpr uint32_t kNoThread = ~0u;
+  int64_t ns = 0;
+  uint32_t thread = kNoThread;
+  bool oneThread = true;
+  double ms() const { return oneThread ? double(ns) * 1e-6 : 0.0; }
+};
+
+// Fed one thread's events in recording order (a new walker per thread).
+class GlueWalker {
+ public:
+  GlueWalker(uint32_t thread, uint32_t firstFrame, std::vector<FrameGlue>& glue) : thread_(thread), firstFrame_(firstFrame), glue_(glue) {}
+  void add(const ProfileEvent& e) {
+    if (e.stage < 0) return;  // envelopes (around stages) and zones outside the stages
+    const bool sameFrame = last_ && last_->frame == e.frame;
+    if (e.beside) {
+      // A beside job this thread ran (inline, with one thread): its time is beside work, not glue.
+      if (sameFrame) lastEnd_ = std::max(lastEnd_, e.endNs);
+      return;
+    }
+    if (e.frame >= firstFrame_ && e.frame - firstFrame_ < glue_.size()) {
+      FrameGlue& g = glue_[e.frame - firstFrame_];
+      if (g.thread == FrameGlue::kNoThread) g.thread = thread_;
+      g.oneThread = g.oneThread && g.thread == thread_;
+      if (sameFrame && last_->stage != e.stage && e.beginNs > lastEnd_) g.ns += e.beginNs - lastEnd_;
+    }
+    lastEnd_ = sameFrame ? std::max(lastEnd_, e.endNs) : e.endNs;
+    last_ = &e;
+  }
+
+ private:
+  uint32_t thread_, firstFrame_;
+  std::vector<FrameGlue>& glue_;
+  const ProfileEvent* last_ = nullptr;  // the previous staged zone
+  int64_t lastEnd_ = 0;                 // the latest end in its frame so far
+};
+
 // A frame's zones summed stage by stage: a frame has a few dozen stages, or thousands when a
 // coloured island makes a stage of each colour and iteration. Zones of one stage mostly come
 // one after another (checked first); other stages are found through an open-addressing table
@@ -124,6 +203,9 @@ class StageSums {
     s.longest = std::max(s.longest, ms);
     if (e.serial) s.serial += ms;
   }
+
+  /// The frame's glue (see WorkSpan), added to its work and span by the next workSpan() or totals().
+  void setGlue(double ms) { glueMs_ = ms; }
 
   /// Sums of the stages added since the last call, in ascending stage order; then starts over.
   WorkSpan workSpan() {
@@ -148,8 +230,9 @@ class StageSums {
     ws.stages = int(n);
     ws.besideWorkMs = besideWork_;
     ws.besideSpanMs = besideLongest_;
-    ws.workMs += besideWork_;
-    ws.spanMs = std::max(ws.spanMs, besideLongest_);
+    ws.glueMs = glueMs_;
+    ws.workMs += besideWork_ + glueMs_;
+    ws.spanMs = std::max(ws.spanMs + glueMs_, besideLongest_);
     startOver();
     return ws;
   }
@@ -163,8 +246,9 @@ class StageSums {
       t.spanMs += std::max(s.longest, s.serial);
     }
     t.stages = stages_.size();
-    t.workMs += besideWork_;
-    t.spanMs = std::max(t.spanMs, besideLongest_);
+    t.glueMs = glueMs_;
+    t.workMs += besideWork_ + glueMs_;
+    t.spanMs = std::max(t.spanMs + glueMs_, besideLongest_);
     startOver();
     return t;
   }
@@ -175,7 +259,7 @@ class StageSums {
     for (const StageTime& s : stages_) index_[s.bucket] = kEmpty;
     stages_.clear();
     last_ = 0;
-    besideWork_ = besideLongest_ = 0;
+    besideWork_ = besideLongest_ = glueMs_ = 0;
   }
   uint32_t slot(int32_t stage) {
     if (index_.empty()) index_.assign(256, kEmpty);
@@ -213,9 +297,11 @@ class StageSums {
   std::vector<uint64_t> keys_;
   uint32_t last_ = 0;
   double besideWork_ = 0, besideLongest_ = 0;  // ms: the beside zones (outside the stages)
+  double glueMs_ = 0;
 };
 
-// Calls done(sums) after adding each frame 0 .. frames-1's job zones to one StageSums. The zones
+// Calls done(sums) after adding each frame 0 .. frames-1's job zones (and, for the whole frame:
+// every stage wanted, its glue) to one StageSums. The zones
 // are grouped by frame with a counting sort, buffer by buffer and each in its order, so a
 // frame's zones are added in the order workSpan(frame) adds them: O(events) and a few
 // allocations (a StageSums per frame, its stage list searched for each stage, cost ~480
@@ -230,12 +316,20 @@ void sumFrameByFrame(const Buffers& buffers, uint32_t frames, int32_t firstStage
   for (uint32_t f = 0; f < frames; ++f) firstOfFrame[f + 1] += firstOfFrame[f];
   std::vector<const ProfileEvent*> byFrame(firstOfFrame[frames]);
   std::vector<uint32_t> next(firstOfFrame.begin(), firstOfFrame.end() - 1);
-  for (const auto& b : buffers)
-    for (const ProfileEvent& e : b->events)
+  // Glue needs every staged zone: between two wanted stages may lie one that is not.
+  const bool withGlue = firstStage <= 0 && lastStage == INT32_MAX;
+  std::vector<FrameGlue> glue(withGlue ? frames : 0);
+  for (const auto& b : buffers) {
+    GlueWalker walker(b->thread, 0, glue);
+    for (const ProfileEvent& e : b->events) {
+      if (withGlue) walker.add(e);
       if (wanted(e)) byFrame[next[e.frame]++] = &e;
+    }
+  }
   StageSums stages;
   for (uint32_t f = 0; f < frames; ++f) {
     for (uint32_t k = firstOfFrame[f]; k < firstOfFrame[f + 1]; ++k) stages.add(*byFrame[k]);
+    if (!glue.empty()) stages.setGlue(glue[f].ms());
     done(stages);
   }
 }
@@ -257,6 +351,7 @@ WorkSpanTotals Profiler::workSpanTotals(uint32_t frames) const {
     const WorkSpanTotals t = stages.totals();
     all.workMs += t.workMs;
     all.spanMs += t.spanMs;
+    all.glueMs += t.glueMs;
     all.stages += t.stages;
   });
   return all;
@@ -264,6 +359,7 @@ WorkSpanTotals Profiler::workSpanTotals(uint32_t frames) const {
 
 WorkSpan Profiler::workSpan(uint32_t frame) const {
   StageSums stages;
+  std::vector<FrameGlue> glue(1);
   std::lock_guard<std::mutex> lock(registry_);
   for (const auto& b : buffers_) {
     size_t begin = 0, end = b->events.size();
@@ -275,11 +371,14 @@ WorkSpan Profiler::workSpan(uint32_t frame) const {
       begin = it->second;
       end = it + 1 == starts.end() ? b->events.size() : (it + 1)->second;
     }
+    GlueWalker walker(b->thread, frame, glue);
     for (size_t k = begin; k < end; ++k) {
       const ProfileEvent& e = b->events[k];
       if (e.frame == frame && e.stage >= 0) stages.add(e);
+      walker.add(e);
     }
   }
+  stages.setGlue(glue[0].ms());
   return stages.workSpan();
 }
 

@@ -45,13 +45,22 @@ struct ProfileEvent {
 /// Beside zones (JobSystem::runBeside: a job a worker runs while the stages go on, which no
 /// stage waits for, like the render thread's wake) are outside the stages' chain: they add to
 /// the work, and the frame takes at least their longest with p threads, not their sum.
+/// Glue: in a frame whose staged zones all ran on one thread (a 1-thread run), the time from
+/// one stage's zone to the next zone of another stage is serial code outside every zone (a
+/// stage's setup, a loop nobody zoned, starting a parallelFor); it is in the work and the span,
+/// and every bound pays it whole. crate_pile's glue was 273 us a frame against a 495 us span
+/// (session 42), so a bound without it promised a 16-thread machine what it cannot do. Gaps
+/// between zones of one stage (a parallelFor's jobs one after another) are its jobs' own
+/// scheduling, paid on whichever thread runs them: not glue. With several threads a thread's
+/// gaps include waiting for the others, so such frames have no glue figure (0).
 struct WorkSpan {
-  double workMs = 0;           ///< sum of all job durations, beside zones included
-  double spanMs = 0;           ///< sum over stages of the longest job (or the longest beside zone)
+  double workMs = 0;           ///< sum of all job durations, beside zones and glue included
+  double spanMs = 0;           ///< sum over stages of the longest job (or the longest beside zone), plus glue
+  double glueMs = 0;           ///< serial time between stages outside any zone (see above)
   double besideWorkMs = 0, besideSpanMs = 0;  ///< the beside zones' sum and longest
   int stages = 0;
   /// Lower bound on the frame time with p threads: the stages' chain, each stage
-  /// max(work / p, longest job), or all the work over p, or the longest beside zone.
+  /// max(work / p, longest job), plus the glue; or all the work over p, or the longest beside zone.
   double boundMs(int threads) const;
   double speedupBound(int threads) const;  ///< workMs / boundMs(p)
   std::vector<double> stageWorkMs, stageSpanMs;
@@ -60,7 +69,7 @@ struct WorkSpan {
 
 /// Work and span summed over frames (what a run reports), without the per-stage lists.
 struct WorkSpanTotals {
-  double workMs = 0, spanMs = 0;
+  double workMs = 0, spanMs = 0, glueMs = 0;
   uint64_t stages = 0;
 };
 

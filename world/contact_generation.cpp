@@ -85,8 +85,11 @@ void World::generateContacts(float dt) {
     pairContacts_.resize(n);
     scratch_.resize(n);
   }
-  pairFlipped_.assign(n, 0);
-  pairStats_.assign(n, ContactStats{});
+  // note: sized here, each pair's entries reset by its contacts job: filling them here was a
+  // serial 31 us a frame on crate_pile (6,900 pairs, 36 bytes each).
+  pairFlipped_.resize(n);
+  pairStats_.resize(n);
+  pairReused_.resize(n);
   ContactParams base;
   base.lodFraction = scene_.settings.lodFraction;
   base.maxContacts = scene_.settings.manifoldSize;
@@ -108,13 +111,15 @@ void World::generateContacts(float dt) {
   // Pair cache: a pair whose relative pose has barely moved reuses its last contacts.
   warm.reset();
   pairCache_.match(pairs_, jobs_, profiler_, stage_ + kContactStepsStage + 1);
-  pairReused_.assign(n, 0);
   // Each pair writes only its own slot: the result does not depend on the thread count.
   jobs_.parallelFor(0, n, tuning::kPairGrain, [&](uint32_t begin, uint32_t end) {
     ProfileZone zone(profiler_, "contacts", stage_ + 1);
     for (uint32_t k = begin; k < end; ++k) {
       std::vector<Contact>& out = pairContacts_[k];
       out.clear();
+      pairFlipped_[k] = 0;  // (terrainPairs() sets its pairs' after this)
+      pairStats_[k] = ContactStats{};
+      pairReused_[k] = 0;
       uint32_t a = pairs_[k].a, b = pairs_[k].b;
       if (!canCollide(a, b) || (!active(a) && !active(b))) continue;  // nothing awake: nothing to do
       if (bodies_.shape[a].isTerrain() || bodies_.shape[b].isTerrain()) continue;  // terrainPairs()

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ranges>
 
+#include "collision/core/assert.h"
 #include "world/contact_update.h"
 #include "world/world_tuning.h"
 
@@ -109,7 +109,9 @@ void ContactSolver::makeContact(const BodyStore& bodies, const BodyPair& pair, u
 
 void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs,
                             const std::vector<std::vector<Contact>>& pairContacts, const std::vector<uint8_t>& flipped,
-                            const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler, int stage) {
+                            const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler, int stage,
+                            int offsetsStage) {
+  if (offsetsStage < 0) offsetsStage = stage + 2;
   coloured_ = false;  // new contacts: the split islands are coloured again
   const uint32_t n = bodies.size();
   inverseInertiaWorld_.resize(n);
@@ -122,34 +124,84 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
   const uint32_t pairCount = uint32_t(pairs.size());
   first_.resize(pairCount + 1);
   first_[0] = 0;
+  // The offsets: each chunk of pairs sums its own (first_ relative to the chunk), the chunks'
+  // sums are added up here, then each chunk adds its start. One thread over every pair was
+  // 48 us a frame on crate_pile (6,900 pairs), serial at any thread count.
   // note: whether the pairs with contacts come in strictly increasing key order (keepImpulses'
-  // fast path) is read here off the compact pair list; a scan of the contacts' keys after the
-  // relax pass missed once per pair (crate_pile on two threads: 38 us a frame, serial).
+  // fast path) is read here off the compact pair list, per chunk and across the chunks' ends; a
+  // scan of the contacts' keys after the relax pass missed once per pair (crate_pile on two
+  // threads: 38 us a frame, serial).
+  const uint32_t offsetGrain = tuning::grainFor(pairCount, tuning::kMinPairGrain);
+  offsetChunks_.resize(JobSystem::chunkCount(0, pairCount, offsetGrain));
+  jobs.parallelFor(0, pairCount, offsetGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "prepare: offsets", offsetsStage);
+    OffsetChunk c;
+    for (uint32_t k = begin; k < end; ++k) {
+      c.contacts += uint32_t(pairContacts[k].size());
+      first_[k + 1] = c.contacts;
+      if (pairContacts[k].empty()) continue;
+      const uint64_t key = (uint64_t(pairs[k].a) << 32) | pairs[k].b;  // makeContact's pairKey
+      c.inOrder = c.inOrder && !(c.any && key <= c.lastKey);
+      if (!c.any) c.firstKey = key;
+      c.any = true;
+      c.lastKey = key;
+    }
+    offsetChunks_[begin / offsetGrain] = c;
+  });
   pairsInKeyOrder_ = true;
-  uint64_t lastKey = 0;
   bool anyKey = false;
-  for (uint32_t k = 0; k < pairCount; ++k) {
-    first_[k + 1] = first_[k] + uint32_t(pairContacts[k].size());
-    if (pairContacts[k].empty()) continue;
-    const uint64_t key = (uint64_t(pairs[k].a) << 32) | pairs[k].b;  // makeContact's pairKey
-    pairsInKeyOrder_ = pairsInKeyOrder_ && !(anyKey && key <= lastKey);
-    anyKey = true;
-    lastKey = key;
+  uint64_t lastKey = 0;
+  uint32_t total = 0;
+  for (OffsetChunk& c : offsetChunks_) {
+    pairsInKeyOrder_ = pairsInKeyOrder_ && c.inOrder && !(anyKey && c.any && c.firstKey <= lastKey);
+    if (c.any) lastKey = c.lastKey;
+    anyKey = anyKey || c.any;
+    const uint32_t start = total;
+    total += c.contacts;
+    c.contacts = start;  // now the chunk's start
   }
-  contacts_.resize(first_[pairCount]);
-  extras_.resize(first_[pairCount]);
-  // Jobs of equal weight, a pair weighing 1 and each of its contacts 1 more (pair k's weight
-  // starts at first_[k] + k): pairs cut evenly left crates_on_grid's jobs 1-12 us (the pairs
-  // near the end of the list had no contacts), the longest a third over the stage's work / 16.
-  const uint64_t weight = uint64_t(first_[pairCount]) + pairCount;
+  // The contacts' jobs hold equal weight, a pair weighing 1 and each of its contacts 1 more
+  // (pair k's weight starts at w(k) = first_[k] + k): pairs cut evenly left crates_on_grid's jobs
+  // 1-12 us (the pairs near the end of the list had no contacts), the longest a third over the
+  // stage's work / 16. Job j starts at the first pair whose weight starts at or past j / jobs of
+  // the total: found by the chunk whose pairs' weights span that point, as it places its offsets.
+  const uint64_t weight = uint64_t(total) + pairCount;
   const uint32_t jobCount = uint32_t(std::clamp<uint64_t>(weight / kMinPrepareWeight, 1, tuning::kTargetJobs));
   prepareJobStart_.resize(jobCount + 1);
-  const auto pairIndices = std::views::iota(0u, pairCount);
-  for (uint32_t j = 0; j < jobCount; ++j) {  // job j starts at the first pair whose weight starts at or past its share
-    const uint64_t at = weight * j / jobCount;
-    prepareJobStart_[j] = *std::ranges::partition_point(pairIndices, [&](uint32_t k) { return uint64_t(first_[k]) + k < at; });
-  }
+  prepareJobStart_[0] = 0;
   prepareJobStart_[jobCount] = pairCount;
+  const uint32_t offsetChunkCount = uint32_t(offsetChunks_.size());
+  jobs.parallelFor(0, pairCount, offsetGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone z(profiler, "prepare: offsets", offsetsStage + 1);
+    const uint32_t c = begin / offsetGrain;
+    const uint32_t start = offsetChunks_[c].contacts;
+    for (uint32_t k = begin; k < end; ++k) first_[k + 1] += start;
+    // This chunk's weights: [w(begin), w(end)), w(end) the next chunk's first (first_[begin] is
+    // the chunk before's to write: its start stands in).
+    const uint64_t lo = uint64_t(start) + begin;
+    const uint64_t hi = uint64_t(c + 1 < offsetChunkCount ? offsetChunks_[c + 1].contacts : total) + end;
+    uint32_t k = begin;
+    for (uint32_t j = 1; j < jobCount; ++j) {
+      const uint64_t at = weight * j / jobCount;
+      if (at < lo || at >= hi) continue;
+      while (k < end && uint64_t(k == begin ? start : first_[k]) + k < at) ++k;
+      prepareJobStart_[j] = k;
+    }
+  });
+#ifdef BW_ENABLE_ASSERTS
+  for (uint32_t j = 0; j < jobCount; ++j) {  // each start against a binary search of the weights
+    const uint64_t at = weight * j / jobCount;
+    uint32_t lo = 0, hi = pairCount;
+    while (lo < hi) {
+      const uint32_t mid = lo + (hi - lo) / 2;
+      if (uint64_t(first_[mid]) + mid < at) lo = mid + 1;
+      else hi = mid;
+    }
+    BW_ASSERT(prepareJobStart_[j] == lo);
+  }
+#endif
+  contacts_.resize(total);
+  extras_.resize(total);
   jobs.parallelFor(0, jobCount, 1, [&](uint32_t jobBegin, uint32_t jobEnd) {
     ProfileZone z(profiler, "prepare: contacts", stage + 1);
     for (uint32_t k = prepareJobStart_[jobBegin]; k < prepareJobStart_[jobEnd]; ++k) {
@@ -343,15 +395,11 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint3
   // wave starts when the one before has finished, as a fork-join per colour would, without
   // a fork-join's wake and wait per colour (which made chunks finer than 64 contacts cost
   // more than they saved on two threads; world_tuning.h).
-  struct Wave {
-    uint32_t colour;
-    int32_t stageId;
-    bool warmStart;
-    uint32_t chunkSize;  // contacts per chunk
-    bool fill, writeBack;  // lanes: the colour's rows laid out before the wave, its impulses back after
-  };
-  std::vector<Wave> waves;
-  std::vector<uint32_t> chunks;
+  std::vector<ColourWave>& waves = waves_;
+  std::vector<uint32_t>& chunks = waveChunks_;
+  waves.clear();
+  chunks.clear();
+  const int32_t slotsInStage = waveStage(stage, wave);
   // A colour in chunks of one size, as many for every thread (each thread's slice of a wave is
   // the same number of chunks): a wave ends with its last chunk, and whole kColourGrain chunks
   // gave one thread a chunk more than another in most waves (crate_pile on two threads: ~100 us
@@ -393,13 +441,19 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint3
     }
     rows.reserve(rowStart[colours]);
   }
-  // The island's bodies into their slots, and back once the waves are done.
+  // The island's bodies into their slots, and back once the waves are done, in parallel (one
+  // thread copying crate_pile's pile in and out was 10 us a pass, serial).
   const std::vector<uint32_t>& slotBodies = colouring.slotBodies();
-  slots_.resize(slotBodies.size());
-  for (size_t i = 0; i < slotBodies.size(); ++i)
-    if (slotBodies[i] != kInvalidIndex) slots_[i] = bodies_[slotBodies[i]];
+  const uint32_t slotCount = uint32_t(slotBodies.size());
+  const uint32_t slotGrain = tuning::grainFor(slotCount, kMinSlotCopyGrain);
+  slots_.resize(slotCount);
+  jobs.parallelFor(0, slotCount, slotGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler, "colour: slots in", slotsInStage);
+    for (uint32_t i = begin; i < end; ++i)
+      if (slotBodies[i] != kInvalidIndex) slots_[i] = bodies_[slotBodies[i]];
+  });
   jobs.parallelWaves(chunks, [&](uint32_t w, uint32_t chunk) {
-    const Wave& v = waves[w];
+    const ColourWave& v = waves[w];
     const std::span<const uint32_t> group = colouring.colour(v.colour);
     const std::span<const IslandColouring::SlotPair> slots = colouring.slotPairs(v.colour);
     const bool serial = v.colour == kMaxColours;  // the serial group: contacts may share bodies
@@ -444,8 +498,12 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint3
         solveContact(group[j], relax, a, b);
     }
   });
-  for (size_t i = 0; i < slotBodies.size(); ++i)
-    if (slotBodies[i] != kInvalidIndex && slots_[i].dynamic) bodies_[slotBodies[i]] = slots_[i];
+  const int32_t slotsOutStage = waveStage(stage, wave);
+  jobs.parallelFor(0, slotCount, slotGrain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler, "colour: slots out", slotsOutStage);
+    for (uint32_t i = begin; i < end; ++i)
+      if (slotBodies[i] != kInvalidIndex && slots_[i].dynamic) bodies_[slotBodies[i]] = slots_[i];
+  });
   if (!relax && settings.shockPropagation) {  // one serial sweep over the whole pile
     ProfileZone zone(profiler, "shock sweep", waveStage(stage, wave), true);
     std::vector<uint32_t> list(colouring.all().begin(), colouring.all().end());

@@ -38,11 +38,13 @@ class ContactSolver {
   /// This substep's solver contacts from the pairs' contacts (pair k's normals point from the
   /// pair's a side to its b side unless flipped[k]), with effective masses, biases and the
   /// warm-start impulses of the previous substep. Parallel on jobs (zones at stage: world
-  /// inertia per body, stage + 1: contacts per pair, each pair writing its own range), the same
-  /// list in the same order for any thread count.
+  /// inertia per body, stage + 1: contacts per pair, each pair writing its own range;
+  /// offsetsStage and offsetsStage + 1, by default stage + 2 and + 3: the pairs' contact
+  /// offsets counted and placed per chunk of pairs), the same list in the same order for any
+  /// thread count.
   void prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs, const std::vector<std::vector<Contact>>& pairContacts,
                const std::vector<uint8_t>& flipped, const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler,
-               int stage);
+               int stage, int offsetsStage = -1);
   const std::vector<SolverContact>& contacts() const { return contacts_; }
   /// The rest of each contact (warm-start key and point, shock and rolling data), same index.
   const std::vector<SolverContactExtras>& contactExtras() const { return extras_; }
@@ -77,6 +79,8 @@ class ContactSolver {
   /// islands a frame ~280 jobs of ~1.6 us each (traced), a tenth of the stage's wall time in
   /// job overhead on one thread.
   static constexpr uint32_t kMinIslandJobContacts = 32;
+  /// Fewest bodies per job copying a split island's bodies to its slots and back (~64 bytes each).
+  static constexpr uint32_t kMinSlotCopyGrain = 256;
   using CacheRange = std::pair<std::vector<CachedImpulse>::const_iterator, std::vector<CachedImpulse>::const_iterator>;
   void makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c, CacheRange cached,
                    const SceneSettings& settings, float dt, SolverContact& s, SolverContactExtras& x) const;
@@ -125,6 +129,14 @@ class ContactSolver {
   std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
   std::vector<uint32_t> islandJobStart_;    // where each job's run of smallIslands_ starts (and the end)
   std::vector<uint32_t> prepareJobStart_;   // prepare(): the first pair of each job (and the end)
+  /// prepare()'s offsets per chunk of pairs: their contacts, whether the chunk's pairs with
+  /// contacts are in strictly increasing key order, its first and last such key.
+  struct OffsetChunk {
+    uint32_t contacts = 0;
+    bool inOrder = true, any = false;
+    uint64_t firstKey = 0, lastKey = 0;
+  };
+  std::vector<OffsetChunk> offsetChunks_;
   // The colourings of this substep's split islands, in solve order; valid for the relax pass
   // once the solve has made them (coloured_; prepare() resets it).
   std::vector<IslandColouring> colourings_;
@@ -132,6 +144,16 @@ class ContactSolver {
   // each colour's rows start (the serial group has none).
   std::vector<IslandLanes::Rows> colourRows_;
   std::vector<std::vector<uint32_t>> colourRowStart_;
+  // A split island's waves (kept from call to call: no allocation in a steady state).
+  struct ColourWave {
+    uint32_t colour;
+    int32_t stageId;
+    bool warmStart;
+    uint32_t chunkSize;    // contacts per chunk
+    bool fill, writeBack;  // lanes: the colour's rows laid out before the wave, its impulses back after
+  };
+  std::vector<ColourWave> waves_;
+  std::vector<uint32_t> waveChunks_;
   bool coloured_ = false;
   ParallelSorter<CachedImpulse, CacheOrder> cacheSorter_;
   std::vector<uint8_t> cacheChunkSorted_;  // keepImpulses: per copy chunk, already in order

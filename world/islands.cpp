@@ -48,6 +48,7 @@ void Islands::build(const std::vector<SolverContact>& contacts, const std::vecto
   const uint32_t n = uint32_t(motion.size());
   parent_.resize(n);
   for (uint32_t i = 0; i < n; ++i) parent_[i] = i;
+  contactBody_.resize(contacts.size());
   // Union-find over the contacts in parallel: a link always hangs the larger of two roots under
   // the smaller (compare-and-swap on the larger, which must still be a root), so every island's
   // root is its smallest body id whatever the order the links were made in: the grouping is a
@@ -57,6 +58,7 @@ void Islands::build(const std::vector<SolverContact>& contacts, const std::vecto
     ProfileZone z(profiler, "islands: union", stage);
     for (uint32_t k = begin; k < end; ++k) {
       const SolverContact& c = contacts[k];
+      contactBody_[k] = motion[c.a] == MotionType::Dynamic ? c.a : c.b;
       if (motion[c.a] != MotionType::Dynamic || motion[c.b] != MotionType::Dynamic) continue;
       for (;;) {
         uint32_t ra = findHalving(parent_, c.a), rb = findHalving(parent_, c.b);
@@ -74,21 +76,17 @@ void Islands::build(const std::vector<SolverContact>& contacts, const std::vecto
   });
 }
 
-void Islands::groupContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs,
-                            Profiler& profiler, int stage) {
+void Islands::groupContacts(JobSystem& jobs, Profiler& profiler, int stage) {
   // Contacts grouped by the island of their dynamic body, islands ordered by root id, contacts
   // in contact order within one (CSR): a sort of (root, contact) keys, which are unique, so
   // the grouping is the same for any thread count. After build(), every body points straight
-  // at its root.
-  const uint32_t m = uint32_t(contacts.size());
-  if (m < ParallelSorter<uint64_t>::kSerialBelow) return groupFewContacts(contacts, motion, profiler, stage);
+  // at its root, and contactBody_ holds each contact's dynamic body.
+  const uint32_t m = uint32_t(contactBody_.size());
+  if (m < ParallelSorter<uint64_t>::kSerialBelow) return groupFewContacts(profiler, stage);
   keys_.resize(m);
   jobs.parallelFor(0, m, tuning::grainFor(m, tuning::kMinIslandGrain), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "islands: keys", stage);
-    for (uint32_t k = begin; k < end; ++k) {
-      const SolverContact& c = contacts[k];
-      keys_[k] = uint64_t(parent_[motion[c.a] == MotionType::Dynamic ? c.a : c.b]) << 32 | k;
-    }
+    for (uint32_t k = begin; k < end; ++k) keys_[k] = uint64_t(parent_[contactBody_[k]]) << 32 | k;
   });
   keySorter_.sort(keys_, false, jobs, &profiler, "islands: group contacts", stage + 1);
   ProfileZone z(profiler, "islands: ranges", stage + 5);
@@ -105,10 +103,9 @@ void Islands::groupContacts(const std::vector<SolverContact>& contacts, const st
 // (stamped, so nothing is cleared per step) sorted, then the contacts counted into them in
 // contact order. The serial sort of monument's ~220 keys was a single job of 8 us a step, a
 // thirtieth of its work/span bound at 8 threads.
-void Islands::groupFewContacts(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, Profiler& profiler,
-                               int stage) {
+void Islands::groupFewContacts(Profiler& profiler, int stage) {
   ProfileZone z(profiler, "islands: group contacts", stage + 1);
-  const uint32_t m = uint32_t(contacts.size());
+  const uint32_t m = uint32_t(contactBody_.size());
   const uint32_t n = uint32_t(parent_.size());
   if (rootSlot_.size() < n) {
     rootSlot_.resize(n);
@@ -121,8 +118,7 @@ void Islands::groupFewContacts(const std::vector<SolverContact>& contacts, const
   contactRoot_.resize(m);
   roots_.clear();
   for (uint32_t k = 0; k < m; ++k) {
-    const SolverContact& c = contacts[k];
-    const uint32_t r = parent_[motion[c.a] == MotionType::Dynamic ? c.a : c.b];
+    const uint32_t r = parent_[contactBody_[k]];
     contactRoot_[k] = r;
     if (rootStamp_[r] != stamp_) {
       rootStamp_[r] = stamp_;

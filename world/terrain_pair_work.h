@@ -22,15 +22,11 @@ struct TerrainPairWork {
     bool cached = false;  // planned from cached chunks (else queried again in pair order)
     bool wet = false;
     WaterContact water;
-    uint32_t firstPiece = 0, pieceCount = 0;
   };
   static constexpr uint32_t kWholeBody = ~0u;
   /// A pair's queries: one, or one per brick of a small grid (kBrickwiseGridBricks).
   struct Group {
     uint32_t pair, firstQuery, queryCount;
-  };
-  struct Piece {
-    uint32_t query, begin, end;  // candidate triangles [begin, end) of that query's plan
   };
   struct PieceOutput {
     std::vector<Contact> contacts;
@@ -40,7 +36,10 @@ struct TerrainPairWork {
   std::vector<Query> queries;
   std::vector<Group> groups;               // in pair order; their queries consecutive
   std::vector<TerrainContactPlan> plans;   // one per query (grows, never shrinks)
-  std::vector<Piece> pieces;
+  /// Query i's pieces are [pieceStart[i], pieceStart[i + 1]) (plan writes each query's count at
+  /// i + 1, cut sums them); its candidate triangles in runs of trianglesPerPiece, in order.
+  std::vector<uint32_t> pieceStart;
+  std::vector<uint8_t> queryRepeats;       // plan: query i's body was queried already
   std::vector<PieceOutput> pieceOutputs;   // one per piece (grows, never shrinks)
   std::vector<Vec3f> faceNormals;          // the apply stage's scratch
   /// select's per-pair and per-chunk counts: a pair's queries (kNoQuery: not a terrain pair
@@ -59,7 +58,7 @@ struct TerrainPairWork {
     bool applyLeft = false;
   };
   std::vector<FinishChunk> finishChunks;
-  std::vector<uint8_t> bodyQueried;        // per body: has a query this substep (all 0 between)
+  std::vector<uint8_t> bodyQueried;        // per body: has a whole-body query this substep (all 0 between; atomic_ref)
   bool bodiesUnique = true;                // no body has two queries (then buoyancy runs per query in parallel)
 };
 

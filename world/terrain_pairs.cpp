@@ -5,8 +5,9 @@
 //   select offsets (one thread): each chunk's offsets; a grid's hull is made here, lazily;
 //   select queries (parallel, per pair): the queries written at their chunk's offsets;
 //   plan   (parallel, per query): the shape, its pose and margin, the candidate triangles from
-//          chunks already in the terrain's cache (TerrainContactPlan only reads), the water;
-//   cut    (one thread): each query's candidates cut into pieces; whether a body has two;
+//          chunks already in the terrain's cache (TerrainContactPlan only reads), the water,
+//          how many pieces the candidates make, whether the body was queried already;
+//   cut    (one thread): the queries' first pieces (a sum over a compact count per query);
 //   pieces (parallel, per piece): the contacts of a few candidate triangles each, so a body
 //          lying across many triangles is spread over several jobs;
 //   finish (parallel, per pair): each query's pieces' contacts joined in order, interior
@@ -22,6 +23,7 @@
 // exceed the cache budget re-meshes more than with serial queries (the default budget holds
 // every shipped scene's chunks).
 #include <algorithm>
+#include <atomic>
 
 #include "collision/bricks/brick_narrowphase.h"
 #include "collision/terrain/terrain_contacts.h"
@@ -131,6 +133,9 @@ void World::terrainPairs(float dt) {
   });
   const uint32_t m = uint32_t(w.queries.size());
   if (w.plans.size() < m) w.plans.resize(m);
+  w.pieceStart.resize(m + 1);
+  w.queryRepeats.resize(m);
+  w.bodyQueried.resize(bodies_.size(), 0);
   jobs_.parallelFor(0, m, grainFor(m, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "terrain: plan", stage_ + kTerrainStage + 3);
     for (uint32_t i = begin; i < end; ++i) {
@@ -151,36 +156,41 @@ void World::terrainPairs(float dt) {
       const Terrain& terrain = *terrains_[q.terrain];
       q.cached = w.plans[i].plan(terrain, q.shape, q.pose, q.margin);
       q.wet = bodies_.motion[q.body] == MotionType::Dynamic && terrainWaterContactChecked(terrain, q.shape, q.pose, q.water);
+      const uint32_t per = trianglesPerPiece(q.shape);
+      w.pieceStart[i + 1] = q.cached ? (w.plans[i].triangleCount() + per - 1) / per : 0;  // (a count: summed in cut)
+      // A body with two whole-body queries (two terrains): its flag was set by the other, in
+      // this job or another (a small grid's bricks are queries of one body, seen in select).
+      // The flags go back to 0 in finish.
+      w.queryRepeats[i] = q.brick == TerrainPairWork::kWholeBody &&
+                          std::atomic_ref<uint8_t>(w.bodyQueried[q.body]).exchange(1, std::memory_order_relaxed) != 0;
     }
   });
   {
-    // Cut each planned query's candidates into pieces (a few microseconds of work each).
+    // note: one pass over two compact arrays: the loop that cut the pieces here and checked the
+    // bodies read every query's record (1.7 us a frame on monument, one thread).
     ProfileZone z(profiler_, "terrain: cut", stage_ + kTerrainStage + 4);
-    w.pieces.clear();
-    w.bodyQueried.resize(bodies_.size(), 0);
+    w.pieceStart[0] = 0;
     for (uint32_t i = 0; i < m; ++i) {
-      TerrainPairWork::Query& q = w.queries[i];
-      // Buoyancy runs per query in parallel (finish) when no body has two queries.
-      w.bodiesUnique &= w.bodyQueried[q.body] == 0;
-      w.bodyQueried[q.body] = 1;
-      q.firstPiece = uint32_t(w.pieces.size());
-      const uint32_t count = q.cached ? w.plans[i].triangleCount() : 0;
-      const uint32_t per = trianglesPerPiece(q.shape);
-      for (uint32_t t = 0; t < count; t += per) w.pieces.push_back({i, t, std::min(count, t + per)});
-      q.pieceCount = uint32_t(w.pieces.size()) - q.firstPiece;
+      w.pieceStart[i + 1] += w.pieceStart[i];
+      w.bodiesUnique &= w.queryRepeats[i] == 0;  // then buoyancy runs per query in parallel (finish)
     }
-    for (const TerrainPairWork::Query& q : w.queries) w.bodyQueried[q.body] = 0;
   }
-  const uint32_t pieceCount = uint32_t(w.pieces.size());
+  // Query i's pieces are [pieceStart[i], pieceStart[i + 1]), piece j of them its candidate
+  // triangles [j * per, (j + 1) * per) (the last one shorter).
+  const uint32_t pieceCount = w.pieceStart[m];
   if (w.pieceOutputs.size() < pieceCount) w.pieceOutputs.resize(pieceCount);
   jobs_.parallelFor(0, pieceCount, grainFor(pieceCount, kMinTerrainGrain), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "terrain pairs", stage_ + kTerrainStage + 5);
+    // The query holding piece `begin`: the last whose first piece is at or before it.
+    uint32_t query = uint32_t(std::upper_bound(w.pieceStart.begin(), w.pieceStart.begin() + m + 1, begin) - w.pieceStart.begin()) - 1;
     for (uint32_t i = begin; i < end; ++i) {
-      const TerrainPairWork::Piece& piece = w.pieces[i];
+      while (i >= w.pieceStart[query + 1]) ++query;
+      const uint32_t per = trianglesPerPiece(w.queries[query].shape), count = w.plans[query].triangleCount();
+      const uint32_t first = (i - w.pieceStart[query]) * per;
       TerrainPairWork::PieceOutput& o = w.pieceOutputs[i];
       o.contacts.clear();
       o.faceNormals.clear();
-      w.plans[piece.query].contactsOfTriangles(piece.begin, piece.end, o.contacts, o.faceNormals);
+      w.plans[query].contactsOfTriangles(first, std::min(count, first + per), o.contacts, o.faceNormals);
     }
   });
   const auto buoyancy = [&](const TerrainPairWork::Query& q) {
@@ -212,7 +222,7 @@ void World::terrainPairs(float dt) {
     const TerrainPairWork::Query& q = w.queries[i];
     const size_t start = out.size();
     faceNormals.clear();
-    for (uint32_t p = q.firstPiece; p < q.firstPiece + q.pieceCount; ++p) {
+    for (uint32_t p = w.pieceStart[i]; p < w.pieceStart[i + 1]; ++p) {
       const TerrainPairWork::PieceOutput& o = w.pieceOutputs[p];
       out.insert(out.end(), o.contacts.begin(), o.contacts.end());
       faceNormals.insert(faceNormals.end(), o.faceNormals.begin(), o.faceNormals.end());
@@ -243,9 +253,12 @@ void World::terrainPairs(float dt) {
       out.clear();
       bool wet = false;
       for (uint32_t i = group.firstQuery; i < group.firstQuery + group.queryCount; ++i) {
+        const TerrainPairWork::Query& q = w.queries[i];
         join(i, out, faceNormals);
-        wet |= w.queries[i].wet;
-        if (w.bodiesUnique && w.queries[i].wet) buoyancy(w.queries[i]);
+        wet |= q.wet;
+        if (w.bodiesUnique && q.wet) buoyancy(q);
+        // plan's flag back to 0 (a body's two queries may be in two jobs: both write 0)
+        if (q.brick == TerrainPairWork::kWholeBody) std::atomic_ref<uint8_t>(w.bodyQueried[q.body]).store(0, std::memory_order_relaxed);
       }
       if (group.queryCount > 1) reduceManifold(out, 0, scene_.settings.manifoldSize);  // a small grid's bricks: one manifold
       if (!w.bodiesUnique || !allCached(group)) {

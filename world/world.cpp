@@ -176,14 +176,15 @@ void World::substep(float dt, int index) {
   stats_.contactsMs += msSince(t);
   t = Clock::now();
   {
-    solver_.prepare(bodies_, pairs_, pairContacts_, pairFlipped_, scene_.settings, dt, jobs_, profiler_, stage + 9);
+    solver_.prepare(bodies_, pairs_, pairContacts_, pairFlipped_, scene_.settings, dt, jobs_, profiler_, stage + 9,
+                    stage + kContactStepsStage + 19);
     {
       ProfileZone z(profiler_, "wake touched", stage + 2);
       // A sleeping body touched by an awake one wakes up (its island rejoins the simulation).
       sleep_.wakeTouched(solver_.contacts());
     }
     islands_.build(solver_.contacts(), bodies_.motion, jobs_, profiler_, stage + 11);
-    islands_.groupContacts(solver_.contacts(), bodies_.motion, jobs_, profiler_, stage + kContactStepsStage + 8);
+    islands_.groupContacts(jobs_, profiler_, stage + kContactStepsStage + 8);
     ProfileZone z(profiler_, "solve (stage)");
     solver_.loadBodies(bodies_, jobs_, profiler_, stage + kContactStepsStage + 4);
     const SolveStats solved = solver_.solve(islands_, bodies_.motion, false, scene_.settings, jobs_, profiler_, stage);

@@ -329,12 +329,13 @@ class World {
   // (kTerrainStage: select, its offsets and queries, plan, cut, pieces, finish, apply), the pair cache and the other steps between
   // (kContactStepsStage: hulls warmed, match, count, update, solver bodies loaded, stored after
   // the solve and after the relax, counters; then + 8 .. + 13 contacts grouped by island;
-  // + 14 .. + 18 the impulses kept for the next substep's warm start: copied, then sorted).
+  // + 14 .. + 18 the impulses kept for the next substep's warm start: copied, then sorted;
+  // + 19, + 20 the solver's contact offsets counted and placed).
   // Every piece of a substep's work is in one of them: work/span sees the whole step.
   static constexpr int kBroadphaseStage = 15;
   static constexpr int kTerrainStage = kBroadphaseStage + IncrementalBroadphase::kStages;
   static constexpr int kContactStepsStage = kTerrainStage + 8;
-  static constexpr int kStagesPerSubstep = kContactStepsStage + 19;
+  static constexpr int kStagesPerSubstep = kContactStepsStage + 21;
 
   SceneDescription scene_;
   JobSystem jobs_;

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <map>
 #include <set>
+#include <thread>
 
 #include "jobs/job_system.h"
 #include "jobs/profiler.h"
@@ -130,6 +131,44 @@ TEST(Profiler, OneFramesWorkSpanEqualsTheWholeRunPassInAnyFrameOrder) {
   }
 }
 
+TEST(Profiler, TimeBetweenStagesOnTheOneThreadIsSerialGlueInTheSpan) {
+  const int64_t us = 1'000;
+  // Stage 0: two 1 ms jobs 0.2 ms apart (a parallelFor's own scheduling, not glue); 0.8 ms
+  // later stage 1's job; stage 2 at once; then a 0.5 ms beside job this thread ran inline (not
+  // glue) and 0.5 ms later stage 3. An envelope zone (stage -1) spans them all.
+  const auto frame = [&](Profiler& p, uint32_t f, bool stage1Elsewhere) {
+    p.beginFrame(f);
+    const int64_t t0 = int64_t(f) * 100'000 * us;
+    p.record("stage 0", t0, t0 + 1000 * us, 0);
+    p.record("stage 0", t0 + 1200 * us, t0 + 2200 * us, 0);
+    if (stage1Elsewhere) {
+      std::thread([&] { p.record("stage 1", t0 + 3000 * us, t0 + 4000 * us, 1); }).join();
+    } else {
+      p.record("stage 1", t0 + 3000 * us, t0 + 4000 * us, 1);
+    }
+    p.record("stage 2", t0 + 4000 * us, t0 + 5000 * us, 2);
+    p.recordBeside("wake", t0 + 5000 * us, t0 + 5500 * us, 2, f);
+    p.record("stage 3", t0 + 6000 * us, t0 + 7000 * us, 3);
+    p.record("envelope", t0, t0 + 10'000 * us, -1);
+  };
+  Profiler p;
+  frame(p, 0, false);
+  frame(p, 1, true);
+  for (const WorkSpan& ws : {p.workSpan(0), p.workSpans(2)[0]}) {
+    EXPECT_NEAR(ws.glueMs, 0.8 + 0.5, 1e-12) << "0.8 ms before stage 1, 0.5 ms before stage 3";
+    EXPECT_NEAR(ws.workMs, 5.0 + 0.5 + 1.3, 1e-12) << "five jobs, the beside job and the glue";
+    EXPECT_NEAR(ws.spanMs, 4.0 + 1.3, 1e-12);
+    EXPECT_NEAR(ws.boundMs(16), 4.0 + 1.3, 1e-12) << "glue is serial at any thread count";
+    EXPECT_NEAR(ws.boundMs(1), ws.workMs, 1e-12);
+    EXPECT_EQ(ws.stages, 4) << "glue is not a stage";
+  }
+  for (const WorkSpan& ws : {p.workSpan(1), p.workSpans(2)[1]})
+    EXPECT_EQ(ws.glueMs, 0.0) << "a frame with zones from two threads: gaps may be waiting, no glue";
+  EXPECT_NEAR(p.workSpanTotals(2).glueMs, 1.3, 1e-12);
+  EXPECT_NEAR(p.workSpanTotals(2).workMs, 2 * 5.5 + 1.3, 1e-12);
+  EXPECT_EQ(p.workSpans(2, 1, 2)[0].glueMs, 0.0) << "some stages alone: the gaps between them hold the others";
+}
+
 TEST(Profiler, ThousandsOfInterleavedStagesSumLikeAMapPerStage) {
   // A coloured island's frame: thousands of stages (ids up to 2^27, as the solver's waves give
   // them), zones of one stage scattered among others; each stage's work, longest and serial
@@ -146,12 +185,18 @@ TEST(Profiler, ThousandsOfInterleavedStagesSumLikeAMapPerStage) {
     double work = 0, longest = 0, serial = 0;
   };
   std::map<int32_t, Sums> expected;
+  // One thread: the gaps before a zone of another stage than the last one's are glue.
+  int64_t glueNs = 0, lastEnd = 0;
+  int32_t lastStage = 0;
   p.beginFrame(2);
   for (int z = 0; z < 20000; ++z) {
     const int32_t stage = next() % 4 == 0 ? int32_t(next() % 40) : (1 << 20) + int32_t(next() % 1500) * 65536 + int32_t(next() % 3);
     const int64_t begin = int64_t(next() % 1000000), length = int64_t(next() % 50000);
     const bool serial = next() % 5 == 0;
     p.record("zone", begin, begin + length, stage, serial);
+    if (z > 0 && stage != lastStage && begin > lastEnd) glueNs += begin - lastEnd;
+    lastEnd = z == 0 ? begin + length : std::max(lastEnd, begin + length);
+    lastStage = stage;
     Sums& s = expected[stage];
     const double ms = double(length) * 1e-6;
     s.work += ms;
@@ -170,8 +215,11 @@ TEST(Profiler, ThousandsOfInterleavedStagesSumLikeAMapPerStage) {
     span += std::max(s.longest, s.serial);
     ++k;
   }
-  EXPECT_NEAR(ws.workMs, work, 1e-9 * work);
-  EXPECT_NEAR(ws.spanMs, span, 1e-9 * span);
+  const double glue = double(glueNs) * 1e-6;
+  EXPECT_GT(glue, 0.0);
+  EXPECT_NEAR(ws.glueMs, glue, 1e-9 * glue);
+  EXPECT_NEAR(ws.workMs, work + glue, 1e-9 * work);
+  EXPECT_NEAR(ws.spanMs, span + glue, 1e-9 * span);
   EXPECT_GT(expected.size(), 3000u);
 }
 

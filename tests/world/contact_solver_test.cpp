@@ -29,7 +29,7 @@ void solvePrepared(ContactSolver& solver, BodyStore& bodies, JobSystem& jobs, Pr
   const SceneSettings settings;
   Islands islands;
   islands.build(solver.contacts(), bodies.motion, jobs, profiler, 0);
-  islands.groupContacts(solver.contacts(), bodies.motion, jobs, profiler, 0);
+  islands.groupContacts(jobs, profiler, 0);
   solver.loadBodies(bodies, jobs, profiler);
   solver.solve(islands, bodies.motion, false, settings, jobs, profiler, 0);
   solver.solve(islands, bodies.motion, true, settings, jobs, profiler, 0);

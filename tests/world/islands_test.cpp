@@ -72,7 +72,7 @@ TEST(Islands, ParallelUnionFindEqualsSerialForAnyThreadCount) {
       Profiler profiler;
       Islands& islands = kept[t];
       islands.build(contacts, motion, jobs, profiler, 0);
-      islands.groupContacts(contacts, motion, jobs, profiler, 2);
+      islands.groupContacts(jobs, profiler, 2);
       for (uint32_t i = 0; i < bodies; ++i) ASSERT_EQ(islands.root(i), expected[i]) << "body " << i;
       std::vector<uint32_t> grouped;
       for (uint32_t is = 0; is < islands.count(); ++is)
