@@ -48,7 +48,7 @@ struct ProfileEvent {
 /// Glue: in a frame whose staged zones all ran on one thread (a 1-thread run), the time from
 /// one stage's zone to the next zone of another stage is serial code outside every zone (a
 /// stage's setup, a loop nobody zoned, starting a parallelFor); it is in the work and the span,
-/// and every bound pays it whole. crate_pile's glue was 273 us a frame against a 495 us span
+/// and every bound pays it whole. crate_pile's glue was 194-260 us a frame against a ~500 us span
 /// (session 42), so a bound without it promised a 16-thread machine what it cannot do. Gaps
 /// between zones of one stage (a parallelFor's jobs one after another) are its jobs' own
 /// scheduling, paid on whichever thread runs them: not glue. With several threads a thread's

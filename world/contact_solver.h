@@ -129,8 +129,9 @@ class ContactSolver {
   std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
   std::vector<uint32_t> islandJobStart_;    // where each job's run of smallIslands_ starts (and the end)
   std::vector<uint32_t> prepareJobStart_;   // prepare(): the first pair of each job (and the end)
-  /// prepare()'s offsets per chunk of pairs: their contacts, whether the chunk's pairs with
-  /// contacts are in strictly increasing key order, its first and last such key.
+  /// prepare()'s offsets per chunk of pairs: their contacts (once summed, the chunk's first
+  /// contact), whether the chunk's pairs with contacts are in strictly increasing key order, its
+  /// first and last such key.
   struct OffsetChunk {
     uint32_t contacts = 0;
     bool inOrder = true, any = false;
