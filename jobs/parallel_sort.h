@@ -37,7 +37,8 @@ class ParallelSorter {
   /// Sample elements per bucket when choosing the splitters.
   static constexpr uint32_t kOversample = 16;
 
-  void sort(std::vector<T>& v, bool unique, JobSystem& jobs, Profiler* profiler, const char* zone, int stage) {
+  template <class Alloc>
+  void sort(std::vector<T, Alloc>& v, bool unique, JobSystem& jobs, Profiler* profiler, const char* zone, int stage) {
     const uint32_t n = uint32_t(v.size());
     if (n < kSerialBelow) {
       Zone z(profiler, zone, stage);

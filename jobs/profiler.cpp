@@ -143,7 +143,9 @@ namespace {
 
 // Glue (see WorkSpan) of frames [firstFrame, firstFrame + glue.size()) from each thread's events
 // in recording order: the gap before a staged zone whose stage differs from the previous staged
-// zone's of the same frame on this thread. A frame with staged zones from two threads has none.
+// zone's of the same frame on this thread (a zone that begins exactly where the one before it
+// ended continues that zone's job: the chain keeps its first zone's stage). A frame with staged
+// zones from two threads has none.
 struct FrameGlue {
   static constexpr uint32_t kNoThread = ~0u;
   int64_t ns = 0;
@@ -164,12 +166,14 @@ class GlueWalker {
       if (sameFrame) lastEnd_ = std::max(lastEnd_, e.endNs);
       return;
     }
+    const bool continues = sameFrame && e.beginNs == last_->endNs;
     if (e.frame >= firstFrame_ && e.frame - firstFrame_ < glue_.size()) {
       FrameGlue& g = glue_[e.frame - firstFrame_];
       if (g.thread == FrameGlue::kNoThread) g.thread = thread_;
       g.oneThread = g.oneThread && g.thread == thread_;
-      if (sameFrame && last_->stage != e.stage && e.beginNs > lastEnd_) g.ns += e.beginNs - lastEnd_;
+      if (sameFrame && !continues && chainStage_ != e.stage && e.beginNs > lastEnd_) g.ns += e.beginNs - lastEnd_;
     }
+    if (!continues) chainStage_ = e.stage;
     lastEnd_ = sameFrame ? std::max(lastEnd_, e.endNs) : e.endNs;
     last_ = &e;
   }
@@ -178,6 +182,7 @@ class GlueWalker {
   uint32_t thread_, firstFrame_;
   std::vector<FrameGlue>& glue_;
   const ProfileEvent* last_ = nullptr;  // the previous staged zone
+  int32_t chainStage_ = 0;              // the stage of the first zone of last_'s back-to-back chain
   int64_t lastEnd_ = 0;                 // the latest end in its frame so far
 };
 

@@ -51,7 +51,11 @@ struct ProfileEvent {
 /// and every bound pays it whole. crate_pile's glue was 194-260 us a frame against a ~500 us span
 /// (session 42), so a bound without it promised a 16-thread machine what it cannot do. Gaps
 /// between zones of one stage (a parallelFor's jobs one after another) are its jobs' own
-/// scheduling, paid on whichever thread runs them: not glue. With several threads a thread's
+/// scheduling, paid on whichever thread runs them: not glue. A job may split its time into zones
+/// of two stages recorded back to back (the second begins at the first's end, one clock read):
+/// the chain counts as its first zone's stage, so the gaps between such jobs of one loop are
+/// its scheduling too (the transform update's jobs, update then submission, made 61 gaps a
+/// frame of "glue" on crates_on_grid, 10 us). With several threads a thread's
 /// gaps include waiting for the others, so such frames have no glue figure (0).
 struct WorkSpan {
   double workMs = 0;           ///< sum of all job durations, beside zones and glue included

@@ -200,8 +200,8 @@ void ContactSolver::prepare(const BodyStore& bodies, const std::vector<BodyPair>
     BW_ASSERT(prepareJobStart_[j] == lo);
   }
 #endif
-  contacts_.resize(total);
-  extras_.resize(total);
+  resizeForOverwrite(contacts_, total);  // every field a contact reads is written by makeContact
+  resizeForOverwrite(extras_, total);
   jobs.parallelFor(0, jobCount, 1, [&](uint32_t jobBegin, uint32_t jobEnd) {
     ProfileZone z(profiler, "prepare: contacts", stage + 1);
     for (uint32_t k = prepareJobStart_[jobBegin]; k < prepareJobStart_[jobEnd]; ++k) {
@@ -511,43 +511,29 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint3
   }
 }
 
-SolveStats ContactSolver::solve(const Islands& islands, const std::vector<MotionType>& motion, bool relax,
-                                const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage) {
-  // Islands touch disjoint dynamic bodies: solving them in parallel is race-free and gives the
-  // same result as solving them one by one. Islands above kSplitContacts are split by colour
-  // instead (first, one at a time, each on every thread); which islands are split depends only
-  // on their size, so the result does not depend on the thread count.
-  SolveStats stats;
+void ContactSolver::planIslands(const Islands& islands) {
   smallIslands_.clear();
-  uint32_t wave = 0;
-  // The relax pass solves the same islands over the same contacts: it reuses their colourings.
-  const bool reuse = relax && coloured_;
+  splitIslands_.clear();
+  largestIsland_ = 0;
+  uint64_t smallContacts = 0;
   for (uint32_t i = 0; i < islands.count(); ++i) {
-    const uint32_t size = uint32_t(islands.contacts(i).size());
-    stats.largestIsland = std::max(stats.largestIsland, size);
+    const uint32_t size = islands.size(i);
+    largestIsland_ = std::max(largestIsland_, size);
     if (size > kSplitContacts) {
-      if (stats.splitIslands == colourings_.size()) {
-        colourings_.emplace_back();
-        colourRows_.emplace_back();
-        colourRowStart_.emplace_back();
-      }
-      solveIslandInColours(islands.contacts(i), stats.splitIslands, reuse, motion, relax, settings, jobs,
-                           profiler, stage + (relax ? 5 : 3), wave);
-      ++stats.splitIslands;
+      splitIslands_.push_back(i);
     } else {
       smallIslands_.push_back(i);
+      smallContacts += size;
     }
   }
   // Jobs of consecutive islands holding about 1/kTargetJobs of their contacts each (at least
   // kMinIslandJobContacts); an island that alone reaches that is a job of its own, so the
   // stage's span stays its largest island. (Which islands share a job changes no result.)
-  uint64_t smallContacts = 0;
-  for (uint32_t i : smallIslands_) smallContacts += islands.contacts(i).size();
   const uint64_t perJob = std::max<uint64_t>(kMinIslandJobContacts, (smallContacts + tuning::kTargetJobs - 1) / tuning::kTargetJobs);
   islandJobStart_.clear();
   uint64_t inJob = 0;
   for (uint32_t k = 0; k < smallIslands_.size(); ++k) {
-    const uint64_t size = islands.contacts(smallIslands_[k]).size();
+    const uint64_t size = islands.size(smallIslands_[k]);
     if (k == 0 || inJob + size > perJob) {
       islandJobStart_.push_back(k);
       inJob = 0;
@@ -555,6 +541,32 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
     inJob += size;
   }
   islandJobStart_.push_back(uint32_t(smallIslands_.size()));
+}
+
+SolveStats ContactSolver::solve(const Islands& islands, const std::vector<MotionType>& motion, bool relax,
+                                const SceneSettings& settings, JobSystem& jobs, Profiler& profiler, int stage) {
+  // Islands touch disjoint dynamic bodies: solving them in parallel is race-free and gives the
+  // same result as solving them one by one. Islands above kSplitContacts are split by colour
+  // instead (first, one at a time, each on every thread); which islands are split depends only
+  // on their size, so the result does not depend on the thread count.
+  // The relax pass solves the same islands over the same contacts: it reuses their colourings,
+  // and the plan below (two serial passes over the islands: 7-8 us a substep on crates_on_grid's
+  // ~1,000, in the work/span bound's serial glue).
+  const bool reuse = relax && coloured_;
+  if (!reuse) planIslands(islands);
+  SolveStats stats;
+  stats.largestIsland = largestIsland_;
+  uint32_t wave = 0;
+  for (uint32_t i : splitIslands_) {
+    if (stats.splitIslands == colourings_.size()) {
+      colourings_.emplace_back();
+      colourRows_.emplace_back();
+      colourRowStart_.emplace_back();
+    }
+    solveIslandInColours(islands.contacts(i), stats.splitIslands, reuse, motion, relax, settings, jobs, profiler,
+                         stage + (relax ? 5 : 3), wave);
+    ++stats.splitIslands;
+  }
   jobs.parallelFor(0, uint32_t(islandJobStart_.size() - 1), 1, [&](uint32_t b, uint32_t e) {
     ProfileZone zone(profiler, relax ? "relax" : "island", stage + (relax ? 5 : 3));
     solveIslandsInLanes(islands, std::span<const uint32_t>(smallIslands_).subspan(islandJobStart_[b], islandJobStart_[e] - islandJobStart_[b]),
@@ -566,7 +578,7 @@ SolveStats ContactSolver::solve(const Islands& islands, const std::vector<Motion
 
 void ContactSolver::keepImpulses(JobSystem& jobs, Profiler& profiler, int stage) {
   const uint32_t n = uint32_t(contacts_.size());
-  nextCache_.resize(n);
+  resizeForOverwrite(nextCache_, n);
   if (pairsInKeyOrder_) {
     // The pairs come in key order (the broadphase sorts them), each pair's contacts in its own
     // range: sorting each range by feature gives the list a stable sort of the whole by pair and

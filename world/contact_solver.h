@@ -9,12 +9,14 @@
 ///   islands.build(solver.contacts(), bodies.motion);
 ///   solver.loadBodies(bodies, jobs, prof); solver.solve(islands, false, ...); solver.storeBodies(bodies, jobs, prof);
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
 #include <oneapi/tbb/cache_aligned_allocator.h>
 
 #include "collision/bricks/contact.h"
+#include "collision/core/overwrite_vector.h"
 #include "jobs/job_system.h"
 #include "jobs/parallel_sort.h"
 #include "jobs/profiler.h"
@@ -45,9 +47,9 @@ class ContactSolver {
   void prepare(const BodyStore& bodies, const std::vector<BodyPair>& pairs, const std::vector<std::vector<Contact>>& pairContacts,
                const std::vector<uint8_t>& flipped, const SceneSettings& settings, float dt, JobSystem& jobs, Profiler& profiler,
                int stage, int offsetsStage = -1);
-  const std::vector<SolverContact>& contacts() const { return contacts_; }
+  std::span<const SolverContact> contacts() const { return contacts_; }
   /// The rest of each contact (warm-start key and point, shock and rolling data), same index.
-  const std::vector<SolverContactExtras>& contactExtras() const { return extras_; }
+  std::span<const SolverContactExtras> contactExtras() const { return extras_; }
 
   /// Copies the bodies' velocities into the solver's compact records, and back (dynamic only).
   /// Copies the bodies' velocities in (and the solved ones back out), in parallel chunks with
@@ -81,7 +83,7 @@ class ContactSolver {
   static constexpr uint32_t kMinIslandJobContacts = 32;
   /// Fewest bodies per job copying a split island's bodies to its slots and back (~64 bytes each).
   static constexpr uint32_t kMinSlotCopyGrain = 256;
-  using CacheRange = std::pair<std::vector<CachedImpulse>::const_iterator, std::vector<CachedImpulse>::const_iterator>;
+  using CacheRange = std::pair<OverwriteVector<CachedImpulse>::const_iterator, OverwriteVector<CachedImpulse>::const_iterator>;
   void makeContact(const BodyStore& bodies, const BodyPair& pair, uint32_t a, uint32_t b, const Contact& c, CacheRange cached,
                    const SceneSettings& settings, float dt, SolverContact& s, SolverContactExtras& x) const;
   // On the bodies' records (bodies_), or on the given records (a coloured island's slots).
@@ -100,6 +102,8 @@ class ContactSolver {
   void solveIslandInColours(std::span<const uint32_t> island, uint32_t split, bool coloured,
                             const std::vector<MotionType>& motion, bool relax, const SceneSettings& settings,
                             JobSystem& jobs, Profiler& profiler, int stage, uint32_t& wave);
+  // The islands solve() splits by colour, and the jobs of the others (splitIslands_ ...).
+  void planIslands(const Islands& islands);
   // Contact i's impulses as the cache keeps them.
   CachedImpulse cachedImpulse(uint32_t i) const;
 
@@ -116,8 +120,9 @@ class ContactSolver {
     }
   };
 
-  std::vector<SolverContact> contacts_;
-  std::vector<SolverContactExtras> extras_;  // beside contacts_, same index
+  // Sized by prepare() and written whole by its jobs (collision/core/overwrite_vector.h).
+  OverwriteVector<SolverContact> contacts_;
+  OverwriteVector<SolverContactExtras> extras_;  // beside contacts_, same index
   std::vector<SolverBody> bodies_;
   // A coloured island's bodies in its colouring's slots while its waves run (on line pairs of
   // their own: IslandColouring::kSlotsApart).
@@ -125,8 +130,12 @@ class ContactSolver {
   std::vector<Mat3f> inverseInertiaWorld_;  // per body, this substep
   std::vector<uint32_t> first_;             // prepare(): pair k's contacts start at first_[k]
   bool pairsInKeyOrder_ = false;            // prepare(): its pairs with contacts in strictly increasing key order
-  std::vector<CachedImpulse> cache_, nextCache_;
-  std::vector<uint32_t> smallIslands_;      // islands solved whole, in parallel
+  OverwriteVector<CachedImpulse> cache_, nextCache_;  // nextCache_ written whole by keepImpulses()
+  // planIslands(): the islands split by colour (in island order), those solved whole in
+  // parallel, the largest island's contacts; solve() makes the plan, its relax pass reuses it.
+  std::vector<uint32_t> splitIslands_;
+  std::vector<uint32_t> smallIslands_;
+  uint32_t largestIsland_ = 0;
   std::vector<uint32_t> islandJobStart_;    // where each job's run of smallIslands_ starts (and the end)
   std::vector<uint32_t> prepareJobStart_;   // prepare(): the first pair of each job (and the end)
   /// prepare()'s offsets per chunk of pairs: their contacts (once summed, the chunk's first

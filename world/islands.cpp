@@ -43,7 +43,7 @@ uint32_t findHalving(std::vector<uint32_t>& parent, uint32_t x) {
 
 }  // namespace
 
-void Islands::build(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs,
+void Islands::build(std::span<const SolverContact> contacts, const std::vector<MotionType>& motion, JobSystem& jobs,
                     Profiler& profiler, int stage) {
   const uint32_t n = uint32_t(motion.size());
   parent_.resize(n);
@@ -136,7 +136,7 @@ void Islands::groupFewContacts(Profiler& profiler, int stage) {
   for (uint32_t k = 0; k < m; ++k) contacts_[fill_[rootSlot_[contactRoot_[k]]]++] = k;
 }
 
-void IslandColouring::cellsOf(std::span<const uint32_t> island, const std::vector<SolverContactExtras>& points) {
+void IslandColouring::cellsOf(std::span<const uint32_t> island, std::span<const SolverContactExtras> points) {
   const uint32_t n = uint32_t(island.size());
   if (n == 0) {
     byCell_.clear();
@@ -172,8 +172,8 @@ void IslandColouring::cellsOf(std::span<const uint32_t> island, const std::vecto
   for (uint32_t j = 0; j < n; ++j) byCell_[cellStart_[cellOf_[j]]++] = j;
 }
 
-void IslandColouring::colour(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
-                             const std::vector<MotionType>& motion, const std::vector<SolverContactExtras>& points,
+void IslandColouring::colour(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
+                             const std::vector<MotionType>& motion, std::span<const SolverContactExtras> points,
                              JobSystem& jobs, Profiler& profiler, const char* name, int32_t stage, int32_t slotsStage) {
   // The colours and the cells do not depend on each other: side by side on two threads.
   jobs.parallelFor(0, 2, 1, [&](uint32_t task, uint32_t) {
@@ -204,7 +204,7 @@ void IslandColouring::colour(std::span<const uint32_t> island, const std::vector
     if (x != kInvalidIndex) slotOf_[x] = kInvalidIndex;
 }
 
-void IslandColouring::colourGroups(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
+void IslandColouring::colourGroups(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
                                    const std::vector<MotionType>& motion) {
   const uint32_t n = uint32_t(island.size());
   ends_.resize(n);

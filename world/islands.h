@@ -21,7 +21,7 @@ class Islands {
   /// ordered by their root body). Union-find with
   /// the smaller id as root, run over the contacts in parallel on jobs (zones at stage, stage + 1),
   /// makes the grouping a pure function of the contact list.
-  void build(const std::vector<SolverContact>& contacts, const std::vector<MotionType>& motion, JobSystem& jobs, Profiler& profiler,
+  void build(std::span<const SolverContact> contacts, const std::vector<MotionType>& motion, JobSystem& jobs, Profiler& profiler,
              int stage);
   /// Then the contacts of the last build() grouped by island: (root, contact) keys made and
   /// sorted on jobs (zones at stage .. stage + 4), the island ranges read off in one pass
@@ -29,6 +29,8 @@ class Islands {
   void groupContacts(JobSystem& jobs, Profiler& profiler, int stage);
 
   uint32_t count() const { return uint32_t(start_.size() - 1); }
+  /// Island i's contact count.
+  uint32_t size(uint32_t i) const { return start_[i + 1] - start_[i]; }
   /// Indices into the contact list of island i's contacts, in contact order.
   std::span<const uint32_t> contacts(uint32_t i) const {
     return {contacts_.data() + start_[i], contacts_.data() + start_[i + 1]};
@@ -74,8 +76,8 @@ class IslandColouring {
   /// The colours and the cells are two jobs on `jobs` (zones `name` and "colouring: cells" at
   /// `stage`), the slots and the order within colours one serial step after them (zone
   /// "colouring: slots" at `slotsStage`).
-  void colour(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
-              const std::vector<MotionType>& motion, const std::vector<SolverContactExtras>& points, JobSystem& jobs,
+  void colour(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
+              const std::vector<MotionType>& motion, std::span<const SolverContactExtras> points, JobSystem& jobs,
               Profiler& profiler, const char* name, int32_t stage, int32_t slotsStage);
 
   uint32_t colours() const { return uint32_t(start_.size() - 1); }
@@ -107,11 +109,11 @@ class IslandColouring {
 
  private:
   /// The greedy colouring (colourOf_, ends_) and the groups in island order (start_, contacts_).
-  void colourGroups(std::span<const uint32_t> island, const std::vector<SolverContact>& contacts,
+  void colourGroups(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
                     const std::vector<MotionType>& motion);
   /// The Morton cell (16 per axis) of each island contact's point in the points' bounds, and
   /// the island positions in cell order (byCell_).
-  void cellsOf(std::span<const uint32_t> island, const std::vector<SolverContactExtras>& points);
+  void cellsOf(std::span<const uint32_t> island, std::span<const SolverContactExtras> points);
   std::vector<uint64_t> bodyColours_;  // per body: colours taken (all zero between calls)
   std::vector<uint32_t> colourOf_, start_, contacts_, fill_;
   std::vector<uint32_t> solveOrder_;   // contacts_ with each colour in cell order

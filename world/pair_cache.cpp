@@ -69,8 +69,8 @@ void PairCache::update(const std::vector<BodyPair>& pairs, const std::vector<std
     chunkEntries_[c + 1] += chunkEntries_[c];
     chunkContacts_[c + 1] += chunkContacts_[c];
   }
-  nextEntries_.resize(chunkEntries_[chunks]);
-  nextContacts_.resize(chunkContacts_[chunks]);
+  resizeForOverwrite(nextEntries_, chunkEntries_[chunks]);
+  resizeForOverwrite(nextContacts_, chunkContacts_[chunks]);
   jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler, "pair cache: update", stage + 1);
     uint32_t entry = chunkEntries_[begin / grain], slot = chunkContacts_[begin / grain];

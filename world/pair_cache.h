@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "collision/bricks/contact.h"
+#include "collision/core/overwrite_vector.h"
 #include "collision/core/rigid_transform.h"
 #include "jobs/job_system.h"
 #include "jobs/profiler.h"
@@ -53,8 +54,9 @@ class PairCache {
     uint8_t flipped;
     uint32_t first, count;     // range in contacts_
   };
-  std::vector<Entry> entries_, nextEntries_;
-  std::vector<CachedContact> contacts_, nextContacts_;
+  // The next ones are sized by update() and written whole by its jobs.
+  OverwriteVector<Entry> entries_, nextEntries_;
+  OverwriteVector<CachedContact> contacts_, nextContacts_;
   std::vector<int32_t> hits_;  // per pair of this substep: index into entries_ or -1
   std::vector<uint32_t> chunkEntries_, chunkContacts_;  // update(): per chunk counts, then offsets
 };

@@ -13,7 +13,7 @@ void SleepState::reset(uint32_t bodies) {
   asleep_.assign(bodies, 0);
 }
 
-void SleepState::wakeTouched(const std::vector<SolverContact>& contacts) {
+void SleepState::wakeTouched(std::span<const SolverContact> contacts) {
   for (const SolverContact& s : contacts)
     for (uint32_t x : {s.a, s.b})
       if (asleep_[x]) wake(x);

@@ -5,6 +5,7 @@
 /// bodies, the solver and integration; a contact with an awake body or an edit of a grid it
 /// rests on wakes it.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "jobs/job_system.h"
@@ -31,7 +32,7 @@ class SleepState {
     stillTime_[body] = 0.f;
   }
   /// Wakes every sleeping body a contact touches (an awake body touched it).
-  void wakeTouched(const std::vector<SolverContact>& contacts);
+  void wakeTouched(std::span<const SolverContact> contacts);
   /// After a substep of dt seconds: still times grow or restart, and every island (as last
   /// built) whose dynamic bodies have all been still for kSleepTime falls asleep, its
   /// velocities zeroed. Parallel over bodies on jobs (zones at stage and stage + 1); the same

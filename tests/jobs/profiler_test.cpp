@@ -169,6 +169,28 @@ TEST(Profiler, TimeBetweenStagesOnTheOneThreadIsSerialGlueInTheSpan) {
   EXPECT_EQ(p.workSpans(2, 1, 2)[0].glueMs, 0.0) << "some stages alone: the gaps between them hold the others";
 }
 
+TEST(Profiler, AJobsZonesRecordedBackToBackCountAsItsFirstStageForGlue) {
+  const int64_t us = 1'000;
+  // Three jobs of one loop, each timed as an update zone (stage 4) and a submission zone
+  // (stage 5) back to back, 0.3 ms between jobs (the loop's scheduling); stage 6 follows 0.7 ms
+  // after the last (glue). Then a zone that starts 1 ns after stage 6's end: not back to back.
+  Profiler p;
+  p.beginFrame(0);
+  p.record("stage 3", 0, 1000 * us, 3);
+  int64_t t = 1500 * us;  // 0.5 ms of glue before the loop
+  for (int job = 0; job < 3; ++job) {
+    p.record("update", t, t + 400 * us, 4);
+    p.record("submission", t + 400 * us, t + 600 * us, 5);
+    t += 900 * us;
+  }
+  const int64_t stage6 = t - 300 * us + 700 * us;
+  p.record("stage 6", stage6, stage6 + 1000 * us, 6);
+  p.record("stage 7", stage6 + 1000 * us + 1, stage6 + 2000 * us, 7);
+  const WorkSpan ws = p.workSpan(0);
+  EXPECT_NEAR(ws.glueMs, 0.5 + 0.7 + 1e-6, 1e-12) << "before the loop, after it, and the 1 ns gap; none between its jobs";
+  EXPECT_EQ(ws.stages, 5);
+}
+
 TEST(Profiler, ThousandsOfInterleavedStagesSumLikeAMapPerStage) {
   // A coloured island's frame: thousands of stages (ids up to 2^27, as the solver's waves give
   // them), zones of one stage scattered among others; each stage's work, longest and serial
@@ -185,18 +207,23 @@ TEST(Profiler, ThousandsOfInterleavedStagesSumLikeAMapPerStage) {
     double work = 0, longest = 0, serial = 0;
   };
   std::map<int32_t, Sums> expected;
-  // One thread: the gaps before a zone of another stage than the last one's are glue.
-  int64_t glueNs = 0, lastEnd = 0;
-  int32_t lastStage = 0;
+  // One thread: the gaps before a zone of another stage than the last one's are glue (a zone
+  // that begins at the last one's end continues its chain, which keeps its first stage).
+  int64_t glueNs = 0, lastEnd = 0, prevEnd = -1;
+  int32_t chainStage = 0;
+  int chained = 0;
   p.beginFrame(2);
   for (int z = 0; z < 20000; ++z) {
     const int32_t stage = next() % 4 == 0 ? int32_t(next() % 40) : (1 << 20) + int32_t(next() % 1500) * 65536 + int32_t(next() % 3);
-    const int64_t begin = int64_t(next() % 1000000), length = int64_t(next() % 50000);
+    const int64_t begin = z > 0 && next() % 8 == 0 ? prevEnd : int64_t(next() % 1000000), length = int64_t(next() % 50000);
     const bool serial = next() % 5 == 0;
     p.record("zone", begin, begin + length, stage, serial);
-    if (z > 0 && stage != lastStage && begin > lastEnd) glueNs += begin - lastEnd;
+    const bool continues = begin == prevEnd;
+    chained += continues && stage != chainStage ? 1 : 0;
+    if (z > 0 && !continues && stage != chainStage && begin > lastEnd) glueNs += begin - lastEnd;
+    if (!continues) chainStage = stage;
     lastEnd = z == 0 ? begin + length : std::max(lastEnd, begin + length);
-    lastStage = stage;
+    prevEnd = begin + length;
     Sums& s = expected[stage];
     const double ms = double(length) * 1e-6;
     s.work += ms;
@@ -221,6 +248,7 @@ TEST(Profiler, ThousandsOfInterleavedStagesSumLikeAMapPerStage) {
   EXPECT_NEAR(ws.workMs, work + glue, 1e-9 * work);
   EXPECT_NEAR(ws.spanMs, span + glue, 1e-9 * span);
   EXPECT_GT(expected.size(), 3000u);
+  EXPECT_GT(chained, 1000) << "back-to-back zones of another stage than their chain's: the rule is exercised";
 }
 
 TEST(Profiler, ZonesFromManyThreadsGoToATraceThatParses) {

@@ -138,8 +138,8 @@ TEST(ContactSolver, WarmStartPicksWhatABruteForceScanPicks) {
       ContactSolver solver;
       solver.prepare(bodies, pairs, manifolds(), flipped, settings, 1.f / 60, jobs, profiler, 0);
       solvePrepared(solver, bodies, jobs, profiler);
-      const std::vector<SolverContact> last = solver.contacts();
-      const std::vector<SolverContactExtras> lastExtras = solver.contactExtras();
+      const std::vector<SolverContact> last(solver.contacts().begin(), solver.contacts().end());
+      const std::vector<SolverContactExtras> lastExtras(solver.contactExtras().begin(), solver.contactExtras().end());
       ASSERT_GT(last.size(), 300u);
       uint32_t picked = 0, warm = 0;
       solver.prepare(bodies, pairs, manifolds(), flipped, settings, 1.f / 60, jobs, profiler, 0);
