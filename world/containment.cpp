@@ -63,6 +63,63 @@ InsideSolid World::pointInsideSolid(const Vec3d& p, uint32_t self, bool staticGr
   return found;
 }
 
+uint64_t World::terrainChanges() const {
+  uint64_t changes = 0;
+  for (const std::unique_ptr<Terrain>& t : terrains_) changes += t->changeCount();
+  return changes;
+}
+
+double World::staticSolidClearance(const Vec3d& p, double reach) const {
+  thread_local std::vector<uint32_t> candidates;
+  double clearance = reach;
+  // note: local coordinates are rounded to float, and so are the bricks' bounds near them:
+  // 16 ulps of the largest coordinate there (in `unit`s of the local frame) come off.
+  const auto slackAt = [&](const Vec3f& local, double unit) { return (double(local.cwiseAbs().maxCoeff()) * unit + reach) * 0x1p-20 + 1e-9; };
+  visitSolidsReaching(WorldAabb{p - Vec3d::Constant(reach), p + Vec3d::Constant(reach)}, [&](uint32_t g) {
+    const BodyShape& shape = bodies_.shape[g];
+    if (bodies_.motion[g] != MotionType::Static) return false;
+    if (shape.isGrid()) {
+      const BrickGrid& grid = *grids_[shape.grid];
+      const Vec3f local = bodies_.shapePose(g).pointToLocal(p);
+      const double slack = slackAt(local, 1.0);
+      clearance = std::min(clearance, reach - slack);
+      if (clearance <= 0) return true;
+      const float r = float(clearance);
+      candidates.clear();
+      grid.overlapBricks(Aabb{local - Vec3f::Constant(r), local + Vec3f::Constant(r)}, ~0u, candidates);
+      // A brick outside that box is farther than r along some axis; inside it, its shape lies
+      // in its bounds, so the distance to the bounds is a lower bound on the distance to it.
+      for (uint32_t b : candidates) {
+        const Aabb bounds = brickBounds(grid.brick(b));
+        const Vec3f gap = (bounds.min - local).cwiseMax(local - bounds.max).cwiseMax(0.f);
+        clearance = std::min(clearance, double(gap.norm()) - slack);
+      }
+    } else if (shape.isTerrain()) {
+      const Terrain& t = *terrains_[shape.terrain];
+      const double size = double(t.voxelSize());
+      const Vec3f v = t.placement().pointToLocal(p) / t.voxelSize();  // in voxels
+      const double slack = slackAt(v, size);
+      clearance = std::min(clearance, std::min(reach, 2.0 * size) - slack);
+      if (clearance <= 0) return true;
+      // Every cell the ball's box reaches; a solid one's distance is to its closed cube.
+      const float r = float(clearance / size);
+      const Int3 lo{int(std::floor(v.x() - r)), int(std::floor(v.y() - r)), int(std::floor(v.z() - r))};
+      const Int3 hi{int(std::floor(v.x() + r)), int(std::floor(v.y() + r)), int(std::floor(v.z() + r))};
+      for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+          for (int x = lo.x; x <= hi.x; ++x) {
+            const Int3 cell{x, y, z};
+            if (!t.voxels().contains(cell) || !t.voxels().get(cell).isSolid()) continue;
+            const Vec3f corner{float(x), float(y), float(z)};
+            const Vec3f gap = (corner - v).cwiseMax(v - (corner + Vec3f::Ones())).cwiseMax(0.f);
+            clearance = std::min(clearance, double(gap.norm()) * size - slack);
+          }
+    }
+    return clearance <= 0;
+  });
+  return std::max(clearance, 0.0);
+}
+
 uint32_t World::soleSolidReaching(const WorldAabb& box, uint32_t self) const {
   uint32_t found = kInvalidIndex, count = 0;
   visitSolidsReaching(box, [&](uint32_t g) {
@@ -202,6 +259,9 @@ ContainmentTracker::ContainmentTracker(World& world) : world_(world) {
   // yet: the first place it is seen clear becomes one.
   hasClear_.assign(n, 0);
   for (uint32_t i = 0; i < n; ++i) hasClear_[i] = bodies.motion[i] == MotionType::Dynamic && state_[i] == InsideSolid::No;
+  freeRadius2_.assign(n, 0.0);
+  posesSet_ = world.posesSetCount();
+  terrainChanges_ = world.terrainChanges();
   report_ = {};
   for (uint32_t i = 0; i < n; ++i)
     if (state_[i] != InsideSolid::No) {
@@ -223,32 +283,49 @@ const ContainmentReport& ContainmentTracker::update() {
     clearFrame_.push_back(kWorldFrame);
     state_.push_back(bodies.motion[i] == MotionType::Dynamic ? world_.pointInsideSolid(bodies.position[i], i) : InsideSolid::No);
     hasClear_.push_back(bodies.motion[i] == MotionType::Dynamic && state_.back() == InsideSolid::No);
+    freeRadius2_.push_back(0.0);
   }
   // Pass 1, in parallel: the point test and the crossing tests against grids and built terrain
-  // chunks (all only read) for every body that needs a check; a crossing test that needs a
-  // terrain chunk not built yet (building fills the chunk cache) is left for pass 2.
+  // chunks (all only read) for every body that needs a check, and its new state (each body
+  // writes only its own slots); a crossing test that needs a terrain chunk not built yet
+  // (building fills the chunk cache) is left for pass 2.
   world_.indexSolids();
   movingSolids_ = world_.hasMovingSolid();
-  checked_.assign(n, Check::None);
+  terrainLeft_.assign(n, 0);
   checkFrame_.resize(n);
   checkPlace_.resize(n);
   const uint64_t edits = world_.staticGridEdits();
   const bool staticEdited = edits != staticEdits_;
   staticEdits_ = edits;
+  // A brick or a solid voxel may now be inside a free ball: all are dropped.
+  const uint64_t terrainChanges = world_.terrainChanges();
+  if (staticEdited || world_.posesSetCount() != posesSet_ || terrainChanges != terrainChanges_)
+    std::fill(freeRadius2_.begin(), freeRadius2_.end(), 0.0);
+  posesSet_ = world_.posesSetCount();
+  terrainChanges_ = terrainChanges;
+  // The balls answer for static grids and terrains: used and made when there is no other solid.
+  const bool balls = !movingSolids_;
+  constexpr double kFreeMin2 = 4 * kRecheckDistance * kRecheckDistance;  // smaller: the rest test does as well
+  constexpr double kSlow2 = kFreeReach * kFreeReach / 64;  // moved less than an eighth of the reach since the last update
   constexpr double kRecheck2 = kRecheckDistance * kRecheckDistance;
   JobSystem& jobs = world_.jobs();
-  jobs.parallelFor(0, n, tuning::bodyGrain(n), [&](uint32_t begin, uint32_t end) {
+  const uint32_t grain = tuning::bodyGrain(n);
+  chunks_.assign(JobSystem::chunkCount(0, n, grain), Chunk{});
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
+    Chunk chunk;
     for (uint32_t i = begin; i < end; ++i) {
       if (bodies.motion[i] != MotionType::Dynamic) continue;
       const Vec3d& p = bodies.position[i];
-      const Vec3d previous = lastWorld_[i];  // where the last update saw it (each body its own slot)
+      const Vec3d previous = lastWorld_[i];  // where the last update saw it
       lastWorld_[i] = p;
-      if (seenFrame_[i] == kWorldFrame && p == lastSeen_[i]) continue;
       const bool clear = state_[i] == InsideSolid::No;
+      if (seenFrame_[i] == kWorldFrame && p == lastSeen_[i]) {
+        chunk.busy |= !clear;
+        continue;
+      }
       if (clear && !world_.nearSolidLastStep(i)) {
-        checked_[i] = Check::FarFromSolid;
-        checkFrame_[i] = kWorldFrame;
-        checkPlace_[i] = p;
+        // Clear before, and nowhere near a grid or terrain on its whole way here: clear now.
+        settle(i, InsideSolid::No, p, kWorldFrame, p, 0.0);
         continue;
       }
       // At rest (in the frame it was last seen in): checked again once it has moved further
@@ -263,10 +340,12 @@ const ContainmentReport& ContainmentTracker::update() {
           lastClearWorld_[i] = p;
           continue;
         }
+        // Inside the free ball around its last clear place: so is its way from there.
+        if (balls && f == kWorldFrame && clearFrame_[i] == kWorldFrame && (p - lastClear_[i]).squaredNorm() < freeRadius2_[i]) continue;
       }
+      ++chunk.queried;
       const uint32_t frame = frameAt(WorldAabb{p, p}, i);
-      checkFrame_[i] = frame;
-      checkPlace_[i] = toFrame(frame, p);
+      const Vec3d place = toFrame(frame, p);
       // A centre inside a static grid's brick got there through the brick's surface, unless the
       // brick appeared around it (an edit): while static grids are unedited, the crossing test
       // from the last clear place answers for them, and the point test looks at the rest. A
@@ -278,58 +357,63 @@ const ContainmentReport& ContainmentTracker::update() {
         s = viaCrossing && world_.pointInsideSolid(p, i) == InsideSolid::InBrick ? InsideSolid::InBrick : InsideSolid::WentThrough;
       // The crossing test against terrain too, when the chunks it needs are built (it only
       // reads them then); else pass 2 asks it, building them.
-      bool terrainAsked = false;
       if (s == InsideSolid::No && hasClear_[i]) {
         const std::optional<bool> crossed = world_.segmentHitsBuiltTerrain(lastClearWorld_[i], p);
-        terrainAsked = crossed.has_value();
-        if (crossed.value_or(false)) s = InsideSolid::WentThrough;
+        if (!crossed) {
+          terrainLeft_[i] = 1;
+          checkFrame_[i] = frame;
+          checkPlace_[i] = place;
+          chunk.busy = true;
+          continue;
+        }
+        if (*crossed) s = InsideSolid::WentThrough;
       }
-      checked_[i] = s == InsideSolid::InBrick       ? Check::InBrick
-                    : s == InsideSolid::InVoxel     ? Check::InVoxel
-                    : s == InsideSolid::WentThrough ? Check::WentThrough
-                    : terrainAsked                  ? Check::Clear
-                                                    : Check::ClearOfGrids;
+      double free2 = 0;
+      if (balls && s == InsideSolid::No && frame == kWorldFrame && (p - previous).squaredNorm() < kSlow2) {
+        const double r = world_.staticSolidClearance(p, kFreeReach);
+        if (r * r > kFreeMin2) free2 = r * r;
+      }
+      settle(i, s, p, frame, place, free2);
+      chunk.busy |= s != InsideSolid::No;
     }
+    chunks_[begin / grain] = chunk;
   });
-  // Pass 2, in body order: terrain crossings, then every checked body's state.
+  // Pass 2, in body order, over the chunks that hold one: the terrain crossings left, and the
+  // bodies inside solid.
   report_.bodies.clear();
   report_.reasons.clear();
   queried_ = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    const Vec3d& p = bodies.position[i];
-    switch (checked_[i]) {
-      case Check::None: break;
-      case Check::FarFromSolid:
-        // Clear before, and nowhere near a grid or terrain on its whole way here: clear now.
-        lastSeen_[i] = lastClear_[i] = lastClearWorld_[i] = p;
-        seenFrame_[i] = clearFrame_[i] = kWorldFrame;
-        hasClear_[i] = 1;
-        break;
-      default: {
-        ++queried_;
-        InsideSolid s = checked_[i] == Check::InBrick ? InsideSolid::InBrick
-                        : checked_[i] == Check::InVoxel ? InsideSolid::InVoxel
-                        : checked_[i] == Check::WentThrough ? InsideSolid::WentThrough
-                                                              : InsideSolid::No;
-        if (checked_[i] == Check::ClearOfGrids && hasClear_[i] && world_.segmentHitsTerrain(lastClearWorld_[i], p))
-          s = InsideSolid::WentThrough;
-        if (s == InsideSolid::No) {
-          lastClear_[i] = checkPlace_[i];
-          clearFrame_[i] = checkFrame_[i];
-          lastClearWorld_[i] = p;
-          hasClear_[i] = 1;
-        }
-        lastSeen_[i] = checkPlace_[i];
-        seenFrame_[i] = checkFrame_[i];
-        state_[i] = s;
+  for (uint32_t c = 0; c < uint32_t(chunks_.size()); ++c) {
+    queried_ += chunks_[c].queried;
+    if (!chunks_[c].busy) continue;
+    for (uint32_t i = c * grain; i < std::min(n, (c + 1) * grain); ++i) {
+      if (terrainLeft_[i]) {
+        const Vec3d& p = bodies.position[i];
+        const InsideSolid s = world_.segmentHitsTerrain(lastClearWorld_[i], p) ? InsideSolid::WentThrough : InsideSolid::No;
+        settle(i, s, p, checkFrame_[i], checkPlace_[i], 0.0);
       }
-    }
-    if (bodies.motion[i] == MotionType::Dynamic && state_[i] != InsideSolid::No) {
-      report_.bodies.push_back(i);
-      report_.reasons.push_back(state_[i]);
+      if (bodies.motion[i] == MotionType::Dynamic && state_[i] != InsideSolid::No) {
+        report_.bodies.push_back(i);
+        report_.reasons.push_back(state_[i]);
+      }
     }
   }
   return report_;
+}
+
+// A checked body's new state; a clear one's place becomes its last clear place, with the free
+// ball found there (0: none).
+void ContainmentTracker::settle(uint32_t i, InsideSolid s, const Vec3d& p, uint32_t frame, const Vec3d& place, double free2) {
+  if (s == InsideSolid::No) {
+    lastClear_[i] = place;
+    clearFrame_[i] = frame;
+    lastClearWorld_[i] = p;
+    hasClear_[i] = 1;
+    freeRadius2_[i] = free2;
+  }
+  lastSeen_[i] = place;
+  seenFrame_[i] = frame;
+  state_[i] = s;
 }
 
 }  // namespace bw

@@ -51,8 +51,12 @@ struct ContainmentReport {
 /// from a surface), and the crossing test always runs from the last clear place, so no
 /// tunnelling is missed. A body whose only solid neighbour is a moving grid (a crate riding a
 /// kinematic ship) has those places kept in that grid's frame: resting on the ship it is at
-/// rest, and its path is the path relative to the ship. Not while step() runs: it casts rays
-/// into the terrains, which fill their chunk caches.
+/// rest, and its path is the path relative to the ship. In a world whose solids are all
+/// static, a slow body found clear keeps the ball around that place that no brick or solid
+/// voxel reaches into (World::staticSolidClearance): while it stays inside, its way from
+/// there stays inside too, and it is not checked again (a crate rocking on a street moves
+/// millimetres a frame, and its path tests were two thirds of the checks' instructions). Not while step()
+/// runs: it casts rays into the terrains, which fill their chunk caches.
 class ContainmentTracker {
  public:
   /// Takes every dynamic body's current centre as its starting place (a body that starts
@@ -61,6 +65,9 @@ class ContainmentTracker {
   /// Metres a clear body may move before it is checked again (see above): about a sixth of the
   /// thinnest brick (a 3.2 mm plate).
   static constexpr double kRecheckDistance = 0.5e-3;
+  /// The largest free ball kept (metres): wider than any resting body's centre is from the
+  /// surface it rests on, small enough that its query meets only the bricks around it.
+  static constexpr double kFreeReach = 0.5;
   /// Checks every dynamic body that moved since the last update; returns the report.
   const ContainmentReport& update();
   const ContainmentReport& report() const { return report_; }
@@ -68,9 +75,6 @@ class ContainmentTracker {
   uint32_t lastQueried() const { return queried_; }
 
  private:
-  // What pass 1 of update() found for a body (pass 2 turns it into state).
-  // ClearOfGrids: its terrain crossing test is left for pass 2; Clear: of everything.
-  enum class Check : uint8_t { None, FarFromSolid, InBrick, InVoxel, WentThrough, ClearOfGrids, Clear };
   // A body's places are kept in the world (kWorldFrame) or in a solid body's frame.
   static constexpr uint32_t kWorldFrame = ~0u;
   uint32_t frameAt(const WorldAabb& box, uint32_t self) const;  // where a body whose way is `box` keeps its places
@@ -79,10 +83,17 @@ class ContainmentTracker {
   Vec3d fromFrame(uint32_t frame, const Vec3d& q) const { return frame == kWorldFrame ? q : fromSolidFrame(frame, q); }
   Vec3d toSolidFrame(uint32_t solid, const Vec3d& p) const;    // world -> the solid's frame, at its current pose
   Vec3d fromSolidFrame(uint32_t solid, const Vec3d& q) const;  // and back
+  void settle(uint32_t body, InsideSolid s, const Vec3d& p, uint32_t frame, const Vec3d& place, double free2);
+  // Per chunk of pass 1: bodies queried, and whether one is left for pass 2 or inside solid.
+  struct Chunk {
+    uint32_t queried = 0;
+    bool busy = false;
+  };
+  std::vector<Chunk> chunks_;
   bool movingSolids_ = false;  // World::hasMovingSolid() at the last update
   World& world_;
-  std::vector<Check> checked_;
-  std::vector<uint32_t> checkFrame_;  // per body checked by this update: its frame, and
+  std::vector<uint8_t> terrainLeft_;  // per body: its terrain crossing test is left for pass 2, from
+  std::vector<uint32_t> checkFrame_;  // its frame and
   std::vector<Vec3d> checkPlace_;     // its centre in that frame
   uint32_t queried_ = 0;
   uint64_t staticEdits_ = 0;  // World::staticGridEdits() at the last update
@@ -92,6 +103,12 @@ class ContainmentTracker {
   std::vector<Vec3d> lastWorld_;       // per body: centre at the last update, in the world
   std::vector<Vec3d> lastClearWorld_;  // per body: the last centre known clear of every solid but its frame's, in the world
   std::vector<uint8_t> hasClear_; // per body: lastClear_ is set (not for a body that started inside)
+  // Per body: the squared radius of the free ball around lastClear_ (0: none). Set with every
+  // lastClear_, so the ball is always centred there; all dropped when a static grid is edited
+  // or poses are set.
+  std::vector<double> freeRadius2_;
+  uint64_t posesSet_ = 0;           // World::posesSetCount() at the last update
+  uint64_t terrainChanges_ = 0;     // World::terrainChanges() at the last update
   std::vector<InsideSolid> state_;
   ContainmentReport report_;
 };

@@ -609,6 +609,7 @@ void World::setPoses(const std::vector<Vec3d>& positions, const std::vector<Quat
   nearSolid_.assign(n, 1);
   boundsCurrent_ = false;
   solidIndexCurrent_ = false;
+  ++posesSet_;
 }
 
 uint64_t World::stateHash() const {

@@ -196,6 +196,18 @@ class World {
   bool hasMovingSolid() const;
   /// Sum of the static grids' edit counts: changes whenever one is edited.
   uint64_t staticGridEdits() const;
+  /// How many times setPoses() was called: the only way a static grid moves.
+  uint64_t posesSetCount() const { return posesSet_; }
+  /// Sum of the terrains' change counts (Terrain::changeCount): changes whenever one is edited
+  /// or moved.
+  uint64_t terrainChanges() const;
+  /// A lower bound on the distance from `p` (world) to the nearest brick of any static grid or
+  /// solid voxel of any static terrain, capped at `reach` (at two voxels in a terrain, whose
+  /// cells are looked at one by one): no static brick and no terrain triangle (they lie on
+  /// solid voxels' faces) reaches into the ball of that radius around `p`. Bricks count by
+  /// their bounds; a few ulps of the local coordinates are taken off. Reads only, safe on
+  /// many threads.
+  double staticSolidClearance(const Vec3d& p, double reach) const;
   /// Whether the segment from `from` to `to` (world) crosses a static or kinematic grid or a
   /// terrain. Fills terrain chunk caches as rays do, so not while step() runs.
   bool segmentHitsStatic(const Vec3d& from, const Vec3d& to);
@@ -435,6 +447,7 @@ class World {
   static constexpr int kEditStage = 1 << 19;
   StepStats stats_;
   uint32_t frame_ = 0;
+  uint64_t posesSet_ = 0;  // setPoses() calls (posesSetCount)
   int stage_ = 0;  // first profiling stage id of the running substep
   // Render chunks of grid bodies (scenes with attachments), and how many bodies have their
   // attachments (later ones get theirs before the next render frame).

@@ -24,6 +24,7 @@ Terrain::Terrain(const Int3& sizeInVoxels, float voxelSize, const RigidTransform
 void Terrain::setPlacement(const RigidTransform& placement) {
   placement.validate("Terrain::setPlacement: placement");
   placement_ = placement;
+  ++changes_;
 }
 
 void Terrain::setVoxel(const Int3& v, Voxel voxel) {
@@ -39,6 +40,7 @@ void Terrain::fillBox(const Int3& lo, const Int3& hi, Voxel voxel) {
 void Terrain::afterEdit(const Int3& lo, const Int3& hi) {
   broadphase_.rebuildAround(voxels_, lo, hi);
   cache_.invalidateAround(lo, hi);
+  ++changes_;
 }
 
 RigidTransform Terrain::chunkTransform(const Int3& c) const {

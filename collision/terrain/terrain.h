@@ -62,6 +62,8 @@ class Terrain {
   const RigidTransform& placement() const { return placement_; }
   /// Moves the terrain (no rebuild: all data is local).
   void setPlacement(const RigidTransform& placement);
+  /// Edits and moves so far: changes whenever a voxel is written or the terrain is moved.
+  uint64_t changeCount() const { return changes_; }
   /// Chunk-local -> world transform of a chunk.
   RigidTransform chunkTransform(const Int3& chunk) const;
 
@@ -80,6 +82,7 @@ class Terrain {
   ChunkCache cache_;
   float voxelSize_;
   RigidTransform placement_;
+  uint64_t changes_ = 0;
 };
 
 }  // namespace bw

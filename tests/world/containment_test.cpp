@@ -5,6 +5,7 @@
 #include <string>
 #include <gtest/gtest.h>
 
+#include "collision/bricks/brick_geometry.h"
 #include "collision/core/seeded_random.h"
 #include "world/containment.h"
 #include "world/world.h"
@@ -196,6 +197,83 @@ TEST(Containment, OnTerrainShortcutsReportWhatCheckingEveryBodyEveryFrameReports
   EXPECT_GE(framesWithBodiesInside, 50u);  // both crates set under the ground are seen
   for (uint32_t body : setUnder)
     EXPECT_TRUE(std::find(tracker.report().bodies.begin(), tracker.report().bodies.end(), body) != tracker.report().bodies.end()) << body;
+}
+
+// The free balls the tracker keeps (World::staticSolidClearance) against brute force: from
+// random places among a clutter of bricks (thin plates to 4 m blocks, in 24 orientations, on a
+// grid far from the origin and turned) and over a quarry terrain (far from the origin too), the
+// clearance never reaches past the nearest brick's bounds or solid voxel, and is within a
+// millimetre of that distance (capped at the reach: two voxels in a terrain).
+TEST(Containment, AFreeBallReachesNoBrickAndNoSolidVoxel) {
+  SceneDescription scene;
+  scene.name = "clutter";
+  GridDescription clutter;
+  clutter.name = "clutter";
+  clutter.position = Vec3d(5000, -3000, 200);
+  clutter.rotation = Quatf(Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized()));
+  SeededRandom r(17);
+  for (int k = 0; k < 400; ++k) {
+    Brick b = Brick::box(Vec3f(float(r.uniform(-12, 12)), float(r.uniform(-12, 12)), float(r.uniform(-4, 4))),
+                         Vec3f(float(r.uniform(0.1, 2)), float(r.uniform(0.1, 2)), float(k % 4 == 0 ? 0.01 : r.uniform(0.1, 2))));
+    b.rotation = AxisRotation::fromIndex(int(r.below(AxisRotation::kCount)));
+    clutter.bricks.push_back(b);
+  }
+  scene.grids.push_back(clutter);
+  TerrainDescription quarry;
+  quarry.name = "quarry";
+  quarry.generator = "quarry";
+  quarry.size = {32, 32, 16};
+  quarry.seed = 3;
+  quarry.voxelSize = 0.4f;
+  quarry.position = Vec3d(-7000, 2500, -50);
+  scene.terrains.push_back(quarry);
+  World world(scene, 1);
+  world.step();  // (the solids' reach is known after a step)
+  const uint32_t gridBody = world.gridBody("clutter");
+  const RigidTransform gridPose = world.bodies().shapePose(gridBody);
+  const BrickGrid& grid = world.grid(0);
+  const Terrain& terrain = world.terrain(0);
+  constexpr double kReach = 0.5;
+  // Distances in double from the exact local coordinates.
+  const auto nearestBrick = [&](const Vec3d& p) {
+    const Vec3d local = gridPose.rotation.cast<double>().conjugate() * (p - gridPose.translation);
+    double best = 1e30;
+    grid.forEachBrick([&](uint32_t id) {
+      const Aabb b = brickBounds(grid.brick(id));
+      const Vec3d gap = (b.min.cast<double>() - local).cwiseMax(local - b.max.cast<double>()).cwiseMax(0.0);
+      best = std::min(best, gap.norm());
+    });
+    return best;
+  };
+  const auto nearestVoxel = [&](const Vec3d& p) {
+    const double size = terrain.voxelSize();
+    const Vec3d v = (terrain.placement().rotation.cast<double>().conjugate() * (p - terrain.placement().translation)) / size;
+    double best = 1e30;
+    const Int3 n = terrain.voxels().size();
+    for (int z = 0; z < n.z; ++z)
+      for (int y = 0; y < n.y; ++y)
+        for (int x = 0; x < n.x; ++x) {
+          if (!terrain.voxels().get(Int3{x, y, z}).isSolid()) continue;
+          const Vec3d c(x, y, z);
+          best = std::min(best, (c - v).cwiseMax(v - (c + Vec3d::Ones())).cwiseMax(0.0).norm() * size);
+        }
+    return best;
+  };
+  uint32_t free = 0, near = 0;
+  for (int k = 0; k < 600; ++k) {
+    const bool inGrid = k % 2 == 0;
+    const Vec3d p = inGrid ? Vec3d(gridPose.pointToWorld(Vec3f(float(r.uniform(-13, 13)), float(r.uniform(-13, 13)), float(r.uniform(-5, 5)))))
+                           : quarry.position + Vec3d(r.uniform(-1, 13.8), r.uniform(-1, 13.8), r.uniform(-1, 7.4));
+    const double cap = inGrid ? kReach : std::min(kReach, 2.0 * terrain.voxelSize());
+    const double exact = std::min(inGrid ? nearestBrick(p) : nearestVoxel(p), cap);
+    const double clearance = world.staticSolidClearance(p, kReach);
+    ASSERT_LE(clearance, exact) << (inGrid ? "grid" : "terrain") << " point " << k;
+    ASSERT_GE(clearance, exact - 1e-3) << (inGrid ? "grid" : "terrain") << " point " << k;
+    free += clearance > 0.1 ? 1 : 0;
+    near += exact < cap ? 1 : 0;
+  }
+  EXPECT_GE(free, 100u);  // places with room around them
+  EXPECT_GE(near, 100u);  // and places a brick or a solid voxel cuts the ball short
 }
 
 // A crate riding a kinematic deck (4 m/s, a wall across the deck behind the crate) is followed
