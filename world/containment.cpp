@@ -306,7 +306,10 @@ const ContainmentReport& ContainmentTracker::update() {
   // The balls answer for static grids and terrains: used and made when there is no other solid.
   const bool balls = !movingSolids_;
   constexpr double kFreeMin2 = 4 * kRecheckDistance * kRecheckDistance;  // smaller: the rest test does as well
-  constexpr double kSlow2 = kFreeReach * kFreeReach / 64;  // moved less than an eighth of the reach since the last update
+  // A body that moved more than half the reach since the last update leaves its ball at once (a
+  // crate falling at 30 m/s): no ball is made for it (made under 6 cm a frame instead, crates_on_grid
+  // queried 2.3x as many bodies and spent 26% more instructions).
+  constexpr double kSlow2 = kFreeReach * kFreeReach / 4;
   constexpr double kRecheck2 = kRecheckDistance * kRecheckDistance;
   JobSystem& jobs = world_.jobs();
   const uint32_t grain = tuning::bodyGrain(n);
