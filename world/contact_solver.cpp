@@ -384,10 +384,17 @@ void ContactSolver::solveIslandInColours(std::span<const uint32_t> island, uint3
   IslandColouring& colouring = colourings_[split];
   const char* const name = relax ? "relax: colour" : "colour";
   if (!coloured) {
-    const int32_t colourStage = waveStage(stage, wave);  // in this order: each call takes the next id
-    const int32_t slotsStage = waveStage(stage, wave);
-    colouring.colour(island, contacts_, motion, extras_, jobs, profiler, relax ? "relax: colouring" : "colouring", colourStage,
-                     slotsStage);
+    IslandColouring::ColouringStages stages;
+    stages.points = waveStage(stage, wave);  // in this order: each call takes the next id
+    stages.cells = waveStage(stage, wave);
+    stages.colours = waveStage(stage, wave);
+    stages.seen = waveStage(stage, wave);
+    stages.owners = waveStage(stage, wave);
+    stages.lists = waveStage(stage, wave);
+    stages.slots = waveStage(stage, wave);
+    stages.place = waveStage(stage, wave);
+    stages.cleared = waveStage(stage, wave);
+    colouring.colour(island, contacts_, motion, extras_, jobs, profiler, relax ? "relax: colouring" : "colouring", stages);
   }
   const uint32_t colours = colouring.colours();
   // Every pass over the colours in order, as waves of one parallel region: each colour's

@@ -136,36 +136,56 @@ void Islands::groupFewContacts(Profiler& profiler, int stage) {
   for (uint32_t k = 0; k < m; ++k) contacts_[fill_[rootSlot_[contactRoot_[k]]]++] = k;
 }
 
-void IslandColouring::cellsOf(std::span<const uint32_t> island, std::span<const SolverContactExtras> points) {
+void IslandColouring::cellsOf(std::span<const uint32_t> island, std::span<const SolverContactExtras> points, JobSystem& jobs,
+                              Profiler& profiler, int32_t pointsStage, int32_t cellsStage) {
   const uint32_t n = uint32_t(island.size());
-  if (n == 0) {
-    byCell_.clear();
-    return;
-  }
-  // One pass over the contacts' records: each point relative to the first (small, so float
-  // keeps it to well under a cell far from the origin too) and their bounds.
+  cellOf_.resize(n);
+  if (n == 0) return;
+  // Each point relative to the first (small, so float keeps it to well under a cell far from
+  // the origin too), and each job's bounds (min and max: exact in any grouping, so the bounds
+  // are the serial pass's). Both passes read every contact's record, scattered over the
+  // contact list: jobs of their own (one thread's pass was the largest single job of
+  // crate_pile's frame).
   const Vec3d origin = points[island[0]].point;
   relative_.resize(n);
+  const uint32_t grain = tuning::grainFor(n, tuning::kMinIslandGrain);
+  jobBounds_.resize(JobSystem::chunkCount(0, n, grain));
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler, "colouring: points", pointsStage);
+    Vec3f lo = Vec3f::Zero(), hi = Vec3f::Zero();
+    for (uint32_t j = begin; j < end; ++j) {
+      const Vec3f p = (points[island[j]].point - origin).cast<float>();
+      relative_[j] = p;
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    jobBounds_[begin / grain] = {lo, hi};
+  });
   Vec3f lo = Vec3f::Zero(), hi = Vec3f::Zero();
-  for (uint32_t j = 0; j < n; ++j) {
-    const Vec3f p = (points[island[j]].point - origin).cast<float>();
-    relative_[j] = p;
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
+  for (const Aabb& b : jobBounds_) {
+    lo = lo.cwiseMin(b.min);
+    hi = hi.cwiseMax(b.max);
   }
   constexpr int kCells = 16;
   float scale[3];
   for (int a = 0; a < 3; ++a) scale[a] = hi[a] > lo[a] ? float(kCells) / (hi[a] - lo[a]) : 0.f;
-  cellOf_.resize(n);
-  for (uint32_t j = 0; j < n; ++j) {
-    uint32_t q[3];
-    for (int a = 0; a < 3; ++a) q[a] = uint32_t(std::clamp(int((relative_[j][a] - lo[a]) * scale[a]), 0, kCells - 1));
-    // note: x highest, so the code's top bit halves the island across x, not z: a pile is
-    // wider than tall, and a vertical cut between two threads' slices meets fewer bodies.
-    cellOf_[j] = uint16_t(mortonCode(q[0], q[1], q[2]));
-  }
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t end) {
+    ProfileZone zone(profiler, "colouring: cells", cellsStage);
+    for (uint32_t j = begin; j < end; ++j) {
+      uint32_t q[3];
+      for (int a = 0; a < 3; ++a) q[a] = uint32_t(std::clamp(int((relative_[j][a] - lo[a]) * scale[a]), 0, kCells - 1));
+      // note: x highest, so the code's top bit halves the island across x, not z: a pile is
+      // wider than tall, and a vertical cut between two threads' slices meets fewer bodies.
+      cellOf_[j] = uint16_t(mortonCode(q[0], q[1], q[2]));
+    }
+  });
+}
+
+void IslandColouring::sortByCell() {
   // Island positions by cell, island order within a cell.
-  cellStart_.assign(kCells * kCells * kCells + 1, 0);
+  const uint32_t n = uint32_t(cellOf_.size());
+  constexpr uint32_t kCellCount = 16 * 16 * 16;
+  cellStart_.assign(kCellCount + 1, 0);
   for (uint32_t j = 0; j < n; ++j) ++cellStart_[cellOf_[j] + 1];
   for (size_t c = 1; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
   byCell_.resize(n);
@@ -174,34 +194,127 @@ void IslandColouring::cellsOf(std::span<const uint32_t> island, std::span<const 
 
 void IslandColouring::colour(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
                              const std::vector<MotionType>& motion, std::span<const SolverContactExtras> points,
-                             JobSystem& jobs, Profiler& profiler, const char* name, int32_t stage, int32_t slotsStage) {
-  // The colours and the cells do not depend on each other: side by side on two threads.
+                             JobSystem& jobs, Profiler& profiler, const char* name, const ColouringStages& stages) {
+  cellsOf(island, points, jobs, profiler, stages.points, stages.cells);
+  // The colours and the cells' order do not depend on each other: side by side on two threads.
   jobs.parallelFor(0, 2, 1, [&](uint32_t task, uint32_t) {
     if (task == 0) {
-      ProfileZone zone(profiler, name, stage);
+      ProfileZone zone(profiler, name, stages.colours);
       colourGroups(island, contacts, motion);
     } else {
-      ProfileZone zone(profiler, "colouring: cells", stage);
-      cellsOf(island, points);
+      ProfileZone zone(profiler, "colouring: cell order", stages.colours);
+      sortByCell();
     }
   });
-  ProfileZone zone(profiler, "colouring: slots", slotsStage, true);
-  assignSlots(uint32_t(motion.size()));
+  placeInSlots(island, uint32_t(motion.size()), jobs, profiler, stages);
+}
+
+// The serial steps this replaced (slots in the order the cells first meet the bodies, then each
+// colour's contacts placed in cell order) were crate_pile's longest single job after the cells.
+// In five passes of parallel jobs over the island positions, with the same result:
+//   seen:   each body's first meeting in cell order (a position's key 2p + end, the smallest
+//           kept by compare-and-swap in slotOf_, kInvalidIndex between calls); per job, how
+//           many of each colour its cell-order positions hold and of the serial group its
+//           island-order positions;
+//   owners: per job, the fixed and the moving bodies whose first meeting it holds;
+//   lists:  those bodies written in order at their job's offsets (fixed_, moving_);
+//   slots:  each listed body's slot into slotOf_;
+//   place:  each contact at its colour's offset for its job (solveOrder_, slotPairs_);
+//   and then slotOf_ back to kInvalidIndex.
+void IslandColouring::placeInSlots(std::span<const uint32_t> island, uint32_t bodies, JobSystem& jobs, Profiler& profiler,
+                                   const ColouringStages& stages) {
   const uint32_t n = uint32_t(island.size());
+  const uint32_t groups = colours();
+  const uint32_t serial = tuning::kMaxColours;  // the serial group's colour (last group when used)
+  const bool hasSerial = groups == serial + 1;
+  const uint32_t grain = tuning::grainFor(n, tuning::kMinIslandGrain);
+  const uint32_t jobCount = JobSystem::chunkCount(0, n, grain);
+  slotOf_.resize(bodies, kInvalidIndex);
+  jobCounts_.assign(size_t(jobCount) * (groups + 2), 0);  // per job: its groups' counts, then fixed and moving owners
+  const auto counts = [&](uint32_t begin) { return jobCounts_.data() + size_t(begin / grain) * (groups + 2); };
+  const auto end = [&](uint32_t j, int k) { return k ? ends_[j].b : ends_[j].a; };
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t stop) {
+    ProfileZone zone(profiler, "colouring: first meetings", stages.seen);
+    uint32_t* count = counts(begin);
+    for (uint32_t p = begin; p < stop; ++p) {
+      const uint32_t j = byCell_[p];
+      for (int k = 0; k < 2; ++k) {
+        std::atomic_ref<uint32_t> first(slotOf_[end(j, k)]);
+        const uint32_t key = 2 * p + uint32_t(k);
+        uint32_t seen = first.load(std::memory_order_relaxed);
+        while (key < seen && !first.compare_exchange_weak(seen, key, std::memory_order_relaxed)) {
+        }
+      }
+      if (colourOf_[j] != serial) ++count[colourOf_[j]];
+      if (hasSerial && colourOf_[p] == serial) ++count[serial];  // (island order)
+    }
+  });
+  const auto owns = [&](uint32_t p, int k) { return slotOf_[end(byCell_[p], k)] == 2 * p + uint32_t(k); };
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t stop) {
+    ProfileZone zone(profiler, "colouring: owners", stages.owners);
+    uint32_t* count = counts(begin);
+    for (uint32_t p = begin; p < stop; ++p)
+      for (int k = 0; k < 2; ++k)
+        if (owns(p, k)) ++count[groups + ((k ? ends_[byCell_[p]].dynamicB : ends_[byCell_[p]].dynamicA) ? 1 : 0)];
+  });
+  // Counts to offsets, job by job (a few dozen jobs of at most 67 counts).
+  std::vector<uint32_t>& at = fill_;
+  at.assign(start_.begin(), start_.end() - 1);
+  at.push_back(0);  // fixed
+  at.push_back(0);  // moving
+  for (uint32_t c = 0; c < jobCount; ++c) {
+    uint32_t* count = jobCounts_.data() + size_t(c) * (groups + 2);
+    for (uint32_t g = 0; g < groups + 2; ++g) {
+      const uint32_t here = count[g];
+      count[g] = at[g];
+      at[g] += here;
+    }
+  }
+  const uint32_t fixedCount = at[groups], movingCount = at[groups + 1];
+  fixed_.resize(fixedCount);
+  moving_.resize(movingCount);
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t stop) {
+    ProfileZone zone(profiler, "colouring: slot lists", stages.lists);
+    uint32_t* count = counts(begin);
+    for (uint32_t p = begin; p < stop; ++p)
+      for (int k = 0; k < 2; ++k) {
+        if (!owns(p, k)) continue;
+        const Ends& e = ends_[byCell_[p]];
+        if (k ? e.dynamicB : e.dynamicA) moving_[count[groups + 1]++] = end(byCell_[p], k);
+        else fixed_[count[groups]++] = end(byCell_[p], k);
+      }
+  });
+  // Static and kinematic bodies first, then dynamic ones from a multiple of kSlotsApart.
+  const uint32_t firstMoving = (fixedCount + kSlotsApart - 1) / kSlotsApart * kSlotsApart;
+  slotBody_.assign(firstMoving + movingCount, kInvalidIndex);
+  std::copy(fixed_.begin(), fixed_.end(), slotBody_.begin());
+  std::copy(moving_.begin(), moving_.end(), slotBody_.begin() + firstMoving);
+  const uint32_t slots = uint32_t(slotBody_.size());
+  jobs.parallelFor(0, slots, tuning::grainFor(slots, tuning::kMinBodyGrain), [&](uint32_t begin, uint32_t stop) {
+    ProfileZone zone(profiler, "colouring: slots", stages.slots);
+    for (uint32_t i = begin; i < stop; ++i)
+      if (slotBody_[i] != kInvalidIndex) slotOf_[slotBody_[i]] = i;
+  });
   solveOrder_.resize(n);
   slotPairs_.resize(n);
-  fill_.assign(start_.begin(), start_.end() - 1);
-  const auto place = [&](uint32_t j) {
-    const uint32_t p = fill_[colourOf_[j]]++;
-    solveOrder_[p] = island[j];
-    slotPairs_[p] = {slotOf_[ends_[j].a], slotOf_[ends_[j].b]};
-  };
-  for (uint32_t j : byCell_)
-    if (colourOf_[j] != tuning::kMaxColours) place(j);
-  for (uint32_t j = 0; j < n; ++j)
-    if (colourOf_[j] == tuning::kMaxColours) place(j);
-  for (uint32_t x : slotBody_)
-    if (x != kInvalidIndex) slotOf_[x] = kInvalidIndex;
+  jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t stop) {
+    ProfileZone zone(profiler, "colouring: place", stages.place);
+    uint32_t* count = counts(begin);
+    const auto place = [&](uint32_t j, uint32_t q) {
+      solveOrder_[q] = island[j];
+      slotPairs_[q] = {slotOf_[ends_[j].a], slotOf_[ends_[j].b]};
+    };
+    for (uint32_t p = begin; p < stop; ++p) {
+      const uint32_t j = byCell_[p];
+      if (colourOf_[j] != serial) place(j, count[colourOf_[j]]++);
+      if (hasSerial && colourOf_[p] == serial) place(p, count[serial]++);  // (island order)
+    }
+  });
+  jobs.parallelFor(0, slots, tuning::grainFor(slots, tuning::kMinBodyGrain), [&](uint32_t begin, uint32_t stop) {
+    ProfileZone zone(profiler, "colouring: slots cleared", stages.cleared);
+    for (uint32_t i = begin; i < stop; ++i)
+      if (slotBody_[i] != kInvalidIndex) slotOf_[slotBody_[i]] = kInvalidIndex;
+  });
 }
 
 void IslandColouring::colourGroups(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
@@ -234,28 +347,6 @@ void IslandColouring::colourGroups(std::span<const uint32_t> island, std::span<c
   fill_.assign(start_.begin(), start_.end() - 1);
   for (uint32_t j = 0; j < n; ++j) contacts_[fill_[colourOf_[j]]++] = island[j];
   for (const Ends& e : ends_) bodyColours_[e.a] = bodyColours_[e.b] = 0;  // clean for the next island
-}
-
-void IslandColouring::assignSlots(uint32_t bodies) {
-  // Static and kinematic bodies first, then dynamic ones, each in the order the cells meet them.
-  slotOf_.resize(bodies, kInvalidIndex);
-  fixed_.clear();
-  moving_.clear();
-  for (uint32_t j : byCell_) {
-    const Ends& e = ends_[j];
-    for (int k = 0; k < 2; ++k) {
-      const uint32_t x = k ? e.b : e.a;
-      if (slotOf_[x] != kInvalidIndex) continue;
-      std::vector<uint32_t>& list = (k ? e.dynamicB : e.dynamicA) ? moving_ : fixed_;
-      slotOf_[x] = uint32_t(list.size());
-      list.push_back(x);
-    }
-  }
-  const uint32_t firstMoving = (uint32_t(fixed_.size()) + kSlotsApart - 1) / kSlotsApart * kSlotsApart;
-  slotBody_.assign(firstMoving + moving_.size(), kInvalidIndex);
-  std::copy(fixed_.begin(), fixed_.end(), slotBody_.begin());
-  std::copy(moving_.begin(), moving_.end(), slotBody_.begin() + firstMoving);
-  for (uint32_t x : moving_) slotOf_[x] += firstMoving;
 }
 
 }  // namespace bw

@@ -73,12 +73,16 @@ class IslandColouring {
   /// slice of every colour then lies in one part of the pile, and the bodies there stay in its
   /// cache from colour to colour instead of moving between cores at every wave. Contacts of a
   /// colour share no dynamic body, so their order inside it does not change the result.
-  /// The colours and the cells are two jobs on `jobs` (zones `name` and "colouring: cells" at
-  /// `stage`), the slots and the order within colours one serial step after them (zone
-  /// "colouring: slots" at `slotsStage`).
+  /// On `jobs`: the points' cells in two passes of parallel jobs (zones "colouring: points",
+  /// "colouring: cells"), the colours and the cells' order as two jobs side by side (zones
+  /// `name` and "colouring: cell order"), then the slots and the order within colours in five
+  /// passes of parallel jobs (islands.cpp, placeInSlots), each pass at its profiling stage.
+  struct ColouringStages {
+    int32_t points, cells, colours, seen, owners, lists, slots, place, cleared;
+  };
   void colour(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
               const std::vector<MotionType>& motion, std::span<const SolverContactExtras> points, JobSystem& jobs,
-              Profiler& profiler, const char* name, int32_t stage, int32_t slotsStage);
+              Profiler& profiler, const char* name, const ColouringStages& stages);
 
   uint32_t colours() const { return uint32_t(start_.size() - 1); }
   /// Contacts (indices into the contact list) of colour c, in cell order (the serial group,
@@ -111,9 +115,13 @@ class IslandColouring {
   /// The greedy colouring (colourOf_, ends_) and the groups in island order (start_, contacts_).
   void colourGroups(std::span<const uint32_t> island, std::span<const SolverContact> contacts,
                     const std::vector<MotionType>& motion);
-  /// The Morton cell (16 per axis) of each island contact's point in the points' bounds, and
-  /// the island positions in cell order (byCell_).
-  void cellsOf(std::span<const uint32_t> island, std::span<const SolverContactExtras> points);
+  /// The Morton cell (16 per axis) of each island contact's point in the points' bounds
+  /// (cellOf_), in parallel jobs.
+  void cellsOf(std::span<const uint32_t> island, std::span<const SolverContactExtras> points, JobSystem& jobs,
+               Profiler& profiler, int32_t pointsStage, int32_t cellsStage);
+  /// The island positions in cell order (byCell_).
+  void sortByCell();
+  std::vector<Aabb> jobBounds_;        // per job of cellsOf's first pass: its points' bounds
   std::vector<uint64_t> bodyColours_;  // per body: colours taken (all zero between calls)
   std::vector<uint32_t> colourOf_, start_, contacts_, fill_;
   std::vector<uint32_t> solveOrder_;   // contacts_ with each colour in cell order
@@ -121,8 +129,10 @@ class IslandColouring {
   std::vector<uint16_t> cellOf_;       // per island position: its cell
   std::vector<uint32_t> cellStart_, byCell_;  // island positions in cell order (counting sort)
   /// Gives the island's bodies (ids below `bodies`) their slots (slotOf_, slotBody_) from ends_
-  /// in cell order.
-  void assignSlots(uint32_t bodies);
+  /// in cell order, and places each colour's contacts in cell order (solveOrder_, slotPairs_).
+  void placeInSlots(std::span<const uint32_t> island, uint32_t bodies, JobSystem& jobs, Profiler& profiler,
+                    const ColouringStages& stages);
+  std::vector<uint32_t> jobCounts_;  // per job of placeInSlots: its counts, then its offsets
   struct Ends {  // an island contact's bodies, read once
     uint32_t a, b;
     bool dynamicA, dynamicB;

@@ -175,7 +175,7 @@ TEST(IslandColouring, GroupsCellOrderAndSlotsMatchASerialReference) {
       Profiler profiler;
       IslandColouring fresh;
       for (IslandColouring* colouring : {&fresh, &reused}) {
-        colouring->colour(island, contacts, motion, extras, jobs, profiler, "colouring", 0, 1);
+        colouring->colour(island, contacts, motion, extras, jobs, profiler, "colouring", {0, 1, 2, 3, 4, 5, 6, 7, 8});
         ASSERT_EQ(colouring->colours(), groups.size());
         // Slots: every island body once, fixed bodies first, the moving ones from a multiple of
         // kSlotsApart, padding only between them.
