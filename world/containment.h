@@ -55,8 +55,8 @@ struct ContainmentReport {
 /// static, a slow body found clear keeps the ball around that place that no brick or solid
 /// voxel reaches into (World::staticSolidClearance): while it stays inside, its way from
 /// there stays inside too, and it is not checked again (a crate rocking on a street moves
-/// millimetres a frame, and its path tests were two thirds of the checks' instructions). Not while step()
-/// runs: it casts rays into the terrains, which fill their chunk caches.
+/// millimetres a frame, and its path tests were two thirds of the checks' instructions).
+/// Not while step() runs: it casts rays into the terrains, which fill their chunk caches.
 class ContainmentTracker {
  public:
   /// Takes every dynamic body's current centre as its starting place (a body that starts
@@ -104,8 +104,8 @@ class ContainmentTracker {
   std::vector<Vec3d> lastClearWorld_;  // per body: the last centre known clear of every solid but its frame's, in the world
   std::vector<uint8_t> hasClear_; // per body: lastClear_ is set (not for a body that started inside)
   // Per body: the squared radius of the free ball around lastClear_ (0: none). Set with every
-  // lastClear_, so the ball is always centred there; all dropped when a static grid is edited
-  // or poses are set.
+  // lastClear_, so the ball is always centred there; all dropped when a static grid is edited,
+  // a terrain is edited or moved, or poses are set.
   std::vector<double> freeRadius2_;
   uint64_t posesSet_ = 0;           // World::posesSetCount() at the last update
   uint64_t terrainChanges_ = 0;     // World::terrainChanges() at the last update

@@ -211,13 +211,13 @@ void IslandColouring::colour(std::span<const uint32_t> island, std::span<const S
 
 // The serial steps this replaced (slots in the order the cells first meet the bodies, then each
 // colour's contacts placed in cell order) were crate_pile's longest single job after the cells.
-// In five passes of parallel jobs over the island positions, with the same result:
+// In passes of parallel jobs over the island positions, with the same result:
 //   seen:   each body's first meeting in cell order (a position's key 2p + end, the smallest
 //           kept by compare-and-swap in slotOf_, kInvalidIndex between calls); per job, how
 //           many of each colour its cell-order positions hold and of the serial group its
 //           island-order positions;
 //   owners: per job, the fixed and the moving bodies whose first meeting it holds;
-//   lists:  those bodies written in order at their job's offsets (fixed_, moving_);
+//   lists:  those bodies written in order at their job's offsets (slotBody_);
 //   slots:  each listed body's slot into slotOf_;
 //   place:  each contact at its colour's offset for its job (solveOrder_, slotPairs_);
 //   and then slotOf_ back to kInvalidIndex.
@@ -270,9 +270,11 @@ void IslandColouring::placeInSlots(std::span<const uint32_t> island, uint32_t bo
       at[g] += here;
     }
   }
+  // Static and kinematic bodies first, then dynamic ones from a multiple of kSlotsApart.
   const uint32_t fixedCount = at[groups], movingCount = at[groups + 1];
-  fixed_.resize(fixedCount);
-  moving_.resize(movingCount);
+  const uint32_t firstMoving = (fixedCount + kSlotsApart - 1) / kSlotsApart * kSlotsApart;
+  const uint32_t slots = firstMoving + movingCount;
+  slotBody_.assign(slots, kInvalidIndex);
   jobs.parallelFor(0, n, grain, [&](uint32_t begin, uint32_t stop) {
     ProfileZone zone(profiler, "colouring: slot lists", stages.lists);
     uint32_t* count = counts(begin);
@@ -280,16 +282,10 @@ void IslandColouring::placeInSlots(std::span<const uint32_t> island, uint32_t bo
       for (int k = 0; k < 2; ++k) {
         if (!owns(p, k)) continue;
         const Ends& e = ends_[byCell_[p]];
-        if (k ? e.dynamicB : e.dynamicA) moving_[count[groups + 1]++] = end(byCell_[p], k);
-        else fixed_[count[groups]++] = end(byCell_[p], k);
+        if (k ? e.dynamicB : e.dynamicA) slotBody_[firstMoving + count[groups + 1]++] = end(byCell_[p], k);
+        else slotBody_[count[groups]++] = end(byCell_[p], k);
       }
   });
-  // Static and kinematic bodies first, then dynamic ones from a multiple of kSlotsApart.
-  const uint32_t firstMoving = (fixedCount + kSlotsApart - 1) / kSlotsApart * kSlotsApart;
-  slotBody_.assign(firstMoving + movingCount, kInvalidIndex);
-  std::copy(fixed_.begin(), fixed_.end(), slotBody_.begin());
-  std::copy(moving_.begin(), moving_.end(), slotBody_.begin() + firstMoving);
-  const uint32_t slots = uint32_t(slotBody_.size());
   jobs.parallelFor(0, slots, tuning::grainFor(slots, tuning::kMinBodyGrain), [&](uint32_t begin, uint32_t stop) {
     ProfileZone zone(profiler, "colouring: slots", stages.slots);
     for (uint32_t i = begin; i < stop; ++i)

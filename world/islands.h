@@ -75,7 +75,7 @@ class IslandColouring {
   /// colour share no dynamic body, so their order inside it does not change the result.
   /// On `jobs`: the points' cells in two passes of parallel jobs (zones "colouring: points",
   /// "colouring: cells"), the colours and the cells' order as two jobs side by side (zones
-  /// `name` and "colouring: cell order"), then the slots and the order within colours in five
+  /// `name` and "colouring: cell order"), then the slots and the order within colours in six
   /// passes of parallel jobs (islands.cpp, placeInSlots), each pass at its profiling stage.
   struct ColouringStages {
     int32_t points, cells, colours, seen, owners, lists, slots, place, cleared;
@@ -139,7 +139,7 @@ class IslandColouring {
   };
   std::vector<Ends> ends_;             // per island position
   std::vector<SlotPair> slotPairs_;    // per solveOrder_ position
-  std::vector<uint32_t> slotBody_, fixed_, moving_;
+  std::vector<uint32_t> slotBody_;
   std::vector<uint32_t> slotOf_;       // per body: its slot (kInvalidIndex between calls)
 };
 
