@@ -45,6 +45,15 @@ struct BodyStore {
                const RigidTransform& shapeFrame = RigidTransform{});
   /// World pose of the body's collision shape.
   RigidTransform shapePose(uint32_t i) const { return RigidTransform{position[i], rotation[i]} * shapeFromBody[i]; }
+  /// How the body moves through the world: a static body stays put whatever velocity it was
+  /// given; an asleep one moves with the velocity it fell asleep with (its carrier's).
+  Vec3f movingLinear(uint32_t i) const { return motion[i] == MotionType::Static ? Vec3f::Zero() : linearVelocity[i]; }
+  Vec3f movingAngular(uint32_t i) const { return motion[i] == MotionType::Static ? Vec3f::Zero() : angularVelocity[i]; }
+  /// Whether two bodies move alike: the same translation and no turn (two bodies turning alike
+  /// about their own centres still move apart), so their relative pose stays as it is.
+  bool movesAlike(uint32_t a, uint32_t b) const {
+    return movingLinear(a) == movingLinear(b) && (movingAngular(a).array() == 0.f).all() && (movingAngular(b).array() == 0.f).all();
+  }
   /// World-frame inverse inertia tensor.
   Mat3f inverseInertiaWorld(uint32_t i) const {
     const Mat3f R = rotation[i].toRotationMatrix();

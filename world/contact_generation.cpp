@@ -99,7 +99,7 @@ void World::generateContacts(float dt) {
   for (const BodyPair& p : pairs_) {
     const BodyShape& sa = bodies_.shape[p.a];
     const BodyShape& sb = bodies_.shape[p.b];
-    if (sa.isGrid() && sb.isGrid() && canCollide(p.a, p.b) && (active(p.a) || active(p.b))) {
+    if (sa.isGrid() && sb.isGrid() && canCollide(p.a, p.b) && pairMoves(p.a, p.b)) {
       BrickGrid& ga = *grids_[sa.grid];
       BrickGrid& gb = *grids_[sb.grid];
       BrickGrid& smaller = ga.brickCount() <= gb.brickCount() ? ga : gb;
@@ -121,7 +121,7 @@ void World::generateContacts(float dt) {
       pairStats_[k] = ContactStats{};
       pairReused_[k] = 0;
       uint32_t a = pairs_[k].a, b = pairs_[k].b;
-      if (!canCollide(a, b) || (!active(a) && !active(b))) continue;  // nothing awake: nothing to do
+      if (!canCollide(a, b) || !pairMoves(a, b)) continue;  // nothing moves: nothing to do
       if (bodies_.shape[a].isTerrain() || bodies_.shape[b].isTerrain()) continue;  // terrainPairs()
       const RigidTransform poseA{bodies_.position[a], bodies_.rotation[a]}, poseB{bodies_.position[b], bodies_.rotation[b]};
       if (pairCache_.reuse(k, poseA, poseB, scene_.settings.reuseTranslation, scene_.settings.reuseRotation, out, pairFlipped_[k])) {

@@ -65,7 +65,7 @@ void World::terrainPairs(float dt) {
       const uint32_t a = pairs_[k].a, b = pairs_[k].b;
       const bool terrainA = bodies_.shape[a].isTerrain();
       if (!terrainA && !bodies_.shape[b].isTerrain()) continue;
-      if (!canCollide(a, b) || (!active(a) && !active(b))) continue;
+      if (!canCollide(a, b) || !pairMoves(a, b)) continue;
       const uint32_t body = terrainA ? b : a;
       pairFlipped_[k] = body == b;  // normals point from the terrain towards the body
       uint32_t count = 1;

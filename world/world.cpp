@@ -144,11 +144,12 @@ uint64_t World::brickCount() const {
 }
 
 void World::integrate(float dt, int stage) {
-  // Each body writes only its own pose: parallel, the same for any thread count.
+  // Each body writes only its own pose: parallel, the same for any thread count. An asleep
+  // body rides its carrier: it moves as the carrier does (the same velocity, no turn).
   jobs_.parallelFor(0, bodies_.size(), tuning::bodyGrain(bodies_.size()), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "integrate", stage);
     for (uint32_t i = begin; i < end; ++i) {
-      if (bodies_.motion[i] == MotionType::Static || sleep_.asleep(i)) continue;
+      if (bodies_.motion[i] == MotionType::Static || (sleep_.asleep(i) && (bodies_.linearVelocity[i].array() == 0.f).all())) continue;
       bodies_.position[i] += (bodies_.linearVelocity[i] * dt).cast<double>();
       const Vec3f w = bodies_.angularVelocity[i];
       const float angle = w.norm() * dt;
@@ -181,7 +182,7 @@ void World::substep(float dt, int index) {
     {
       ProfileZone z(profiler_, "wake touched", stage + 2);
       // A sleeping body touched by an awake one wakes up (its island rejoins the simulation).
-      sleep_.wakeTouched(solver_.contacts());
+      sleep_.wakeTouched(solver_.contacts(), bodies_, scene_.settings.sleeping);
     }
     islands_.build(solver_.contacts(), bodies_.motion, jobs_, profiler_, stage + 11);
     islands_.groupContacts(jobs_, profiler_, stage + kContactStepsStage + 8);
@@ -249,7 +250,7 @@ void World::markNearSolid(uint32_t k) {
   }
   const bool solidA = isSolid(p.a), solidB = isSolid(p.b);
   if (!solidA && !solidB) return;
-  const bool collided = !pairReused_[k] && canCollide(p.a, p.b) && (active(p.a) || active(p.b)) &&
+  const bool collided = !pairReused_[k] && canCollide(p.a, p.b) && pairMoves(p.a, p.b) &&
                         !bodies_.shape[p.a].isTerrain() && !bodies_.shape[p.b].isTerrain();
   if (collided && pairStats_[k].bricksTested == 0 && pairStats_[k].lodBoxes == 0) return;
   if (solidA) mark(p.b);
@@ -610,6 +611,25 @@ void World::setPoses(const std::vector<Vec3d>& positions, const std::vector<Quat
   boundsCurrent_ = false;
   solidIndexCurrent_ = false;
   ++posesSet_;
+}
+
+void World::setKinematicVelocity(uint32_t body, const Vec3f& linear, const Vec3f& angular) {
+  using scene_limits::kMaxAngularSpeed, scene_limits::kMaxSpeed;
+  const char* what = "World::setKinematicVelocity";
+  if (body >= bodies_.size())
+    throw InvalidInput(std::string(what) + ": body " + std::to_string(body) + " of " + std::to_string(bodies_.size()));
+  if (bodies_.motion[body] != MotionType::Kinematic)
+    throw InvalidInput(std::string(what) + ": body " + std::to_string(body) + " is not kinematic");
+  for (int k = 0; k < 3; ++k) {
+    if (!std::isfinite(linear[k]) || std::abs(linear[k]) > kMaxSpeed)
+      throw InvalidInput(std::string(what) + ": linear velocity component " + std::to_string(k) + " is " + std::to_string(linear[k]) +
+                         " (expected finite, at most " + std::to_string(kMaxSpeed) + " m/s)");
+    if (!std::isfinite(angular[k]) || std::abs(angular[k]) > kMaxAngularSpeed)
+      throw InvalidInput(std::string(what) + ": angular velocity component " + std::to_string(k) + " is " + std::to_string(angular[k]) +
+                         " (expected finite, at most " + std::to_string(kMaxAngularSpeed) + " rad/s)");
+  }
+  bodies_.linearVelocity[body] = linear;
+  bodies_.angularVelocity[body] = angular;
 }
 
 uint64_t World::stateHash() const {

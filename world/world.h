@@ -247,6 +247,11 @@ class World {
   /// dropped. Not while step() runs. InvalidInput (nothing moved) when a list's size is not
   /// the body count or a value is not finite.
   void setPoses(const std::vector<Vec3d>& positions, const std::vector<Quatf>& rotations);
+  /// A kinematic body's new scripted velocities (world frame), from the next step on: a ship
+  /// that turns or changes speed. Bodies asleep riding it meet it again and wake (pairMoves).
+  /// Not while step() runs. InvalidInput (nothing changed) for an unknown or non-kinematic body
+  /// or a component that is not finite or beyond kMaxSpeed / kMaxAngularSpeed.
+  void setKinematicVelocity(uint32_t body, const Vec3f& linear, const Vec3f& angular);
   /// The next frame's edits only (the scene's edit load, then splits, wakes and pair caches),
   /// without simulating it: for a world that follows another engine's run through setPoses()
   /// and must see the same edits (the Bullet baseline's judge). Advances frame(); lastStats()
@@ -303,8 +308,15 @@ class World {
   bool isSolid(uint32_t body) const { return bodies_.shape[body].isGrid() || bodies_.shape[body].isTerrain(); }
   /// The fastest the pair's surfaces can approach (m/s): relative speed plus both spins times radii.
   float closingSpeed(uint32_t a, uint32_t b) const;
-  bool active(uint32_t body) const {
-    return bodies_.motion[body] == MotionType::Kinematic || (bodies_.motion[body] == MotionType::Dynamic && !sleep_.asleep(body));
+  /// Whether the pair's relative pose can change this substep, so it needs contacts: one body is
+  /// an awake dynamic one, or the two (kinematic, static or asleep) move unalike. An asleep body
+  /// moves with the velocity it fell asleep with, its carrier's (SleepState): a crate asleep on
+  /// a deck in uniform flight rides it with no contact made, one on a deck that turns or changes
+  /// speed meets it (and its contacts wake it).
+  bool pairMoves(uint32_t a, uint32_t b) const {
+    const auto awake = [&](uint32_t x) { return bodies_.motion[x] == MotionType::Dynamic && !sleep_.asleep(x); };
+    if (awake(a) || awake(b)) return true;
+    return !bodies_.movesAlike(a, b);
   }
   // The step (world.cpp).
   void substep(float dt, int index);

@@ -94,7 +94,9 @@ uint32_t WorldRender::markMovedBodies(const BodyStore& bodies, const SleepState&
       const bool asleep = sleep.asleep(i);
       const bool wasAsleep = asleepBefore_[i] != 0;
       asleepBefore_[i] = asleep ? 1 : 0;
-      if (!all && (bodies.motion[i] == MotionType::Static || (asleep && wasAsleep))) continue;
+      // (an asleep body riding a carrier moves on)
+      const bool parked = asleep && wasAsleep && (bodies.linearVelocity[i].array() == 0.f).all();
+      if (!all && (bodies.motion[i] == MotionType::Static || parked)) continue;
       const RigidTransform pose = bodies.shapePose(i);
       // note: bits, not values: a pose that changed by one ulp moved (the render scene must
       // equal the world's poses exactly), and -0.0 vs 0.0 is a change we can afford to send.

@@ -75,7 +75,7 @@ Plan planFor(const std::string& name) {
       {"city_rain", {205, true}},    {"carrier_with_ships", {70, true}}, {"monument", {80, true}},
       {"crates_on_grid", {145, true}}, {"lighthouse", {20, false}}, {"truck_in_station", {40, false}},
       {"lighthouse_tiled", {220, true}}, {"carrier_fleet", {70, false}},
-      {"rubble_100k", {240, false}}, {"ship_refit", {70, false}}, {"demolition", {150, false}},
+      {"rubble_100k", {240, false}}, {"ship_refit", {70, true}}, {"demolition", {150, false}},
       {"quarry", {200, false}},      {"soak", {110, false}},
       {"chain", {120, false}},       {"docking", {700, false}},
   };
@@ -96,7 +96,7 @@ const std::map<std::string, uint64_t> kRecordedHashes = {
     {"lighthouse", 0x424c0af14d5e1b68ull},         {"lighthouse_tiled", 0x7dd54e8acede9c40ull},
     {"monument", 0x102fd7fdc0239876ull},           {"plate_stack", 0x5c402c2cf25e9376ull},
     {"stack10", 0x435561b2abd83ed3ull},            {"truck_in_station", 0x26c4c50c88d0a950ull},
-    {"ship_refit", 0x2e2c828e695aa7beull},         {"demolition", 0xdf26bd366f3916bbull},
+    {"ship_refit", 0xe32b3279fc67c1aeull},         {"demolition", 0xdf26bd366f3916bbull},
     {"quarry", 0x35b4e1a218d015f9ull},            {"soak", 0x8365549e556229e0ull},
     {"chain", 0xaa6c2552681d732eull},             {"docking", 0xba1d2e67ea248ef0ull},
 };

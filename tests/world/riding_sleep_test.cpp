@@ -1,0 +1,125 @@
+// Bodies asleep on a kinematic deck in uniform flight ride it (SleepState's carriers): they fall
+// asleep relative to the deck, move with it exactly and make no contacts while it flies
+// straight; a deck that turns keeps them awake, and one that changes speed wakes them.
+#include <gtest/gtest.h>
+
+#include "collision/core/argument_checks.h"
+#include "world/containment.h"
+#include "world/scene_file.h"
+#include "world/world.h"
+
+namespace bw {
+namespace {
+
+// A 20 m x 20 m deck far from the origin, flying at (4, 1, 0) m/s (turning at `turn` rad/s
+// about z), and boxes of 0.2-1.2 m dropped onto it from 0.3-1 m up with the deck's velocity.
+SceneDescription deckScene(float turn) {
+  std::string json = R"({
+    "name": "deck", "settings": {"timestep": 0.016666667, "substeps": 2, "solver_iterations": 10},
+    "grids": [{"name": "deck", "bricks": [{"position": [0, 0, -0.25], "half_size": [10, 10, 0.25]}],
+               "position": [30000, -20000, 100], "motion": "kinematic",
+               "linear_velocity": [4, 1, 0], "angular_velocity": [0, 0, TURN]}],
+    "spawners": [{"shape": "box", "count": 6, "half_extents": [0.1, 0.1, 0.1], "seed": 1, "velocity": [4, 1, 0],
+                  "region": {"min": [29994, -20006, 100.4], "max": [30006, -19994, 101]}},
+                 {"shape": "box", "count": 3, "half_extents": [0.6, 0.4, 0.3], "seed": 2, "velocity": [4, 1, 0],
+                  "region": {"min": [29994, -20006, 101.0], "max": [30006, -19994, 101.2]}}]})";
+  json.replace(json.find("TURN"), 4, std::to_string(turn));
+  return parseScene(json, "deck.json");
+}
+
+constexpr uint32_t kDeck = 0, kBoxes = 9;
+
+// Steps until every box is asleep (at most `frames`); returns the frames stepped.
+int stepUntilAllAsleep(World& world, int frames) {
+  for (int f = 0; f < frames; ++f) {
+    world.step();
+    if (world.sleepingCount() == kBoxes) return f + 1;
+  }
+  return frames;
+}
+
+TEST(RidingSleep, BoxesOnADeckInUniformFlightFallAsleepAndRideItExactly) {
+  World world(deckScene(0.f), 1);
+  ContainmentTracker containment(world);
+  const int settled = stepUntilAllAsleep(world, 300);
+  ASSERT_EQ(world.sleepingCount(), kBoxes) << "after " << settled << " frames";
+  const BodyStore& b = world.bodies();
+  std::vector<Vec3d> onDeck;
+  for (uint32_t i = 1; i <= kBoxes; ++i) {
+    onDeck.push_back(b.position[i] - b.position[kDeck]);
+    EXPECT_EQ(b.linearVelocity[i], b.linearVelocity[kDeck]) << "box " << i << " rides with the deck's velocity";
+    EXPECT_GT(onDeck.back().z(), 0.05) << "box " << i << " rests on the deck's top";
+  }
+  const Vec3d deckBefore = b.position[kDeck];
+  for (int f = 0; f < 120; ++f) {
+    world.step();
+    EXPECT_EQ(world.sleepingCount(), kBoxes) << "frame " << f;
+    EXPECT_EQ(world.lastStats().contacts, 0u) << "frame " << f << ": riders moving alike with the deck make no contacts";
+    EXPECT_EQ(containment.update().count(), 0u);
+  }
+  EXPECT_NEAR((b.position[kDeck] - deckBefore).x(), 4.0 * 2.0, 1e-3);  // 2 s at 4 m/s
+  for (uint32_t i = 1; i <= kBoxes; ++i) {
+    const Vec3d drift = b.position[i] - b.position[kDeck] - onDeck[i - 1];
+    EXPECT_LT(drift.norm(), 1e-9) << "box " << i << " moved on the deck while asleep";
+  }
+}
+
+TEST(RidingSleep, TheSameOnAnyThreadCount) {
+  uint64_t reference = 0;
+  for (int threads : {1, 2, 4}) {
+    World world(deckScene(0.f), threads);
+    for (int f = 0; f < 200; ++f) world.step();
+    EXPECT_EQ(world.sleepingCount(), kBoxes) << threads << " threads";
+    if (threads == 1) reference = world.stateHash();
+    EXPECT_EQ(world.stateHash(), reference) << threads << " threads";
+  }
+}
+
+TEST(RidingSleep, ADeckThatTurnsKeepsItsBoxesAwake) {
+  World world(deckScene(0.05f), 1);
+  ContainmentTracker containment(world);
+  for (int f = 0; f < 300; ++f) {
+    world.step();
+    ASSERT_EQ(world.sleepingCount(), 0u) << "frame " << f << ": a box slept on a turning deck";
+  }
+  EXPECT_EQ(containment.update().count(), 0u);
+}
+
+TEST(RidingSleep, ADeckThatChangesSpeedWakesItsBoxesAndTheyRideOnAtTheNewSpeed) {
+  World world(deckScene(0.f), 1);
+  ContainmentTracker containment(world);
+  stepUntilAllAsleep(world, 300);
+  ASSERT_EQ(world.sleepingCount(), kBoxes);
+  const Vec3f faster(5.f, 1.f, 0.f);
+  world.setKinematicVelocity(kDeck, faster, Vec3f::Zero());
+  world.step();
+  EXPECT_EQ(world.sleepingCount(), 0u) << "the deck sped up under its boxes: every one meets it again";
+  const int settled = stepUntilAllAsleep(world, 600);
+  ASSERT_EQ(world.sleepingCount(), kBoxes) << "after " << settled << " frames at the new speed";
+  const BodyStore& b = world.bodies();
+  for (uint32_t i = 1; i <= kBoxes; ++i) {
+    EXPECT_EQ(b.linearVelocity[i], faster) << "box " << i;
+    EXPECT_GT((b.position[i] - b.position[kDeck]).z(), 0.05) << "box " << i << " still on the deck";
+  }
+  EXPECT_EQ(containment.update().count(), 0u);
+}
+
+TEST(RidingSleep, BadKinematicVelocitiesAreRefusedAndChangeNothing) {
+  World world(deckScene(0.f), 1);
+  const Vec3f before = world.bodies().linearVelocity[kDeck];
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(world.setKinematicVelocity(1, Vec3f::Zero(), Vec3f::Zero()), InvalidInput);  // a dynamic box
+  EXPECT_THROW(world.setKinematicVelocity(99, Vec3f::Zero(), Vec3f::Zero()), InvalidInput);
+  EXPECT_THROW(world.setKinematicVelocity(kDeck, Vec3f(nan, 0, 0), Vec3f::Zero()), InvalidInput);
+  EXPECT_THROW(world.setKinematicVelocity(kDeck, Vec3f(0, 2e4f, 0), Vec3f::Zero()), InvalidInput);
+  EXPECT_THROW(world.setKinematicVelocity(kDeck, Vec3f::Zero(), Vec3f(0, 0, 1e3f)), InvalidInput);
+  EXPECT_EQ(world.bodies().linearVelocity[kDeck], before);
+  try {
+    world.setKinematicVelocity(1, Vec3f::Zero(), Vec3f::Zero());
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("not kinematic"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace bw
