@@ -1,7 +1,9 @@
 // Bodies asleep on a kinematic deck in uniform flight ride it (SleepState's carriers): they fall
 // asleep relative to the deck, move with it exactly and make no contacts while it flies
 // straight; a deck that turns keeps them awake, and one that changes speed wakes them.
+#include <algorithm>
 #include <gtest/gtest.h>
+#include <limits>
 
 #include "collision/core/argument_checks.h"
 #include "world/containment.h"
@@ -102,6 +104,37 @@ TEST(RidingSleep, ADeckThatChangesSpeedWakesItsBoxesAndTheyRideOnAtTheNewSpeed) 
     EXPECT_GT((b.position[i] - b.position[kDeck]).z(), 0.05) << "box " << i << " still on the deck";
   }
   EXPECT_EQ(containment.update().count(), 0u);
+}
+
+// The deck carries its sleeping boxes under a static wall hung 10 cm above its top: the wall
+// moves unalike, so it meets each box, wakes it and holds it back while the deck slides away
+// beneath (the boxes then fall off its back edge). None passes into the wall.
+TEST(RidingSleep, AStaticWallInTheDecksWayWakesItsBoxesAndStopsThem) {
+  SceneDescription scene = deckScene(0.f);
+  const double wallFace = 30018;  // x of the wall's face towards the deck
+  GridDescription wall;
+  wall.name = "wall";
+  wall.position = Vec3d(wallFace + 0.5, -20000, 101.55);  // spans z 100.1-103: a 10 cm gap above the deck
+  wall.bricks.push_back(Brick::box(Vec3f::Zero(), Vec3f(0.5f, 20.f, 1.45f)));
+  scene.grids.push_back(wall);
+  World world(scene, 2);
+  ContainmentTracker containment(world);
+  const BodyStore& b = world.bodies();
+  uint32_t boxes = 0;
+  for (uint32_t i = 0; i < b.size(); ++i) boxes += b.motion[i] == MotionType::Dynamic;
+  ASSERT_EQ(boxes, kBoxes);
+  uint32_t mostAsleep = 0;
+  for (int f = 0; f < 600; ++f) {
+    world.step();
+    mostAsleep = std::max(mostAsleep, world.sleepingCount());
+    ASSERT_EQ(containment.update().count(), 0u) << "frame " << f;
+    for (uint32_t i = 0; i < b.size(); ++i) {
+      if (b.motion[i] != MotionType::Dynamic) continue;
+      ASSERT_LT(b.position[i].x(), wallFace) << "frame " << f << ": body " << i << " went through the wall";
+    }
+  }
+  EXPECT_EQ(mostAsleep, kBoxes) << "the boxes were asleep on the deck before the wall came";
+  EXPECT_EQ(world.sleepingCount(), 0u) << "the wall woke them all";
 }
 
 TEST(RidingSleep, BadKinematicVelocitiesAreRefusedAndChangeNothing) {
