@@ -49,11 +49,12 @@ struct BodyStore {
   /// given; an asleep one moves with the velocity it fell asleep with (its carrier's).
   Vec3f movingLinear(uint32_t i) const { return motion[i] == MotionType::Static ? Vec3f::Zero() : linearVelocity[i]; }
   Vec3f movingAngular(uint32_t i) const { return motion[i] == MotionType::Static ? Vec3f::Zero() : angularVelocity[i]; }
+  /// Whether the body moves through the world / turns (exactly: any component not zero).
+  bool translates(uint32_t i) const { return !(movingLinear(i).array() == 0.f).all(); }
+  bool turns(uint32_t i) const { return !(movingAngular(i).array() == 0.f).all(); }
   /// Whether two bodies move alike: the same translation and no turn (two bodies turning alike
   /// about their own centres still move apart), so their relative pose stays as it is.
-  bool movesAlike(uint32_t a, uint32_t b) const {
-    return movingLinear(a) == movingLinear(b) && (movingAngular(a).array() == 0.f).all() && (movingAngular(b).array() == 0.f).all();
-  }
+  bool movesAlike(uint32_t a, uint32_t b) const { return movingLinear(a) == movingLinear(b) && !turns(a) && !turns(b); }
   /// World-frame inverse inertia tensor.
   Mat3f inverseInertiaWorld(uint32_t i) const {
     const Mat3f R = rotation[i].toRotationMatrix();

@@ -17,22 +17,19 @@ void SleepState::reset(uint32_t bodies) {
 }
 
 void SleepState::wakeTouched(std::span<const SolverContact> contacts, const BodyStore& bodies, bool noteCarriers) {
-  const auto atRest = [&](uint32_t k) {
-    return (bodies.linearVelocity[k].array() == 0.f).all() && (bodies.angularVelocity[k].array() == 0.f).all();
-  };
   for (const SolverContact& s : contacts) {
     for (uint32_t x : {s.a, s.b})
       if (asleep_[x]) wake(x);
     if (!noteCarriers) continue;
     // A dynamic body on a moving kinematic one (one at rest carries as the world does).
     for (const auto& [d, k] : {std::pair{s.a, s.b}, std::pair{s.b, s.a}}) {
-      if (bodies.motion[d] != MotionType::Dynamic || bodies.motion[k] != MotionType::Kinematic || atRest(k)) continue;
+      if (bodies.motion[d] != MotionType::Dynamic || bodies.motion[k] != MotionType::Kinematic) continue;
+      if (!bodies.translates(k) && !bodies.turns(k)) continue;
       uint32_t& c = carrierOfBody_[d];
-      const bool turns = !(bodies.angularVelocity[k].array() == 0.f).all();
       if (c == kNoCarrier) {
         carried_.push_back(d);
-        c = turns ? kUnalikeCarriers : k;
-      } else if (c != kUnalikeCarriers && (turns || !bodies.movesAlike(c, k))) {
+        c = bodies.turns(k) ? kUnalikeCarriers : k;
+      } else if (c != kUnalikeCarriers && !bodies.movesAlike(c, k)) {  // (false when k turns)
         c = kUnalikeCarriers;
       }
     }

@@ -149,7 +149,7 @@ void World::integrate(float dt, int stage) {
   jobs_.parallelFor(0, bodies_.size(), tuning::bodyGrain(bodies_.size()), [&](uint32_t begin, uint32_t end) {
     ProfileZone z(profiler_, "integrate", stage);
     for (uint32_t i = begin; i < end; ++i) {
-      if (bodies_.motion[i] == MotionType::Static || (sleep_.asleep(i) && (bodies_.linearVelocity[i].array() == 0.f).all())) continue;
+      if (bodies_.motion[i] == MotionType::Static || (sleep_.asleep(i) && !bodies_.translates(i))) continue;
       bodies_.position[i] += (bodies_.linearVelocity[i] * dt).cast<double>();
       const Vec3f w = bodies_.angularVelocity[i];
       const float angle = w.norm() * dt;

@@ -95,7 +95,7 @@ uint32_t WorldRender::markMovedBodies(const BodyStore& bodies, const SleepState&
       const bool wasAsleep = asleepBefore_[i] != 0;
       asleepBefore_[i] = asleep ? 1 : 0;
       // (an asleep body riding a carrier moves on)
-      const bool parked = asleep && wasAsleep && (bodies.linearVelocity[i].array() == 0.f).all();
+      const bool parked = asleep && wasAsleep && !bodies.translates(i);
       if (!all && (bodies.motion[i] == MotionType::Static || parked)) continue;
       const RigidTransform pose = bodies.shapePose(i);
       // note: bits, not values: a pose that changed by one ulp moved (the render scene must

@@ -54,8 +54,8 @@ uint64_t finalHash(const SceneDescription& scene, int threads, uint32_t frames, 
 // release (first frame with a body asleep, 1 thread): plate_stack 92, stack10 31, crate_pile 150,
 // city_rain 142, carrier_with_ships 59, monument 57, crates_on_grid 117, lighthouse 212,
 // lighthouse_tiled 203 (its rain lands after ~3 s of fall); ship_refit's crates land on the
-// moving deck by frame ~70 while it is edited every frame; demolition's house loses bricks
-// from frame 30 and its first parts break off and fall before 150; quarry's carving from frame 20
+// moving deck while it is edited every frame, the first asleep riding it at frame 52;
+// demolition's house loses bricks from frame 30 and its first parts break off and fall before 150; quarry's carving from frame 20
 // has cut its first pillar tops and fin slabs free by frame ~50 and they fall among the crates
 // by 200; chain's links take up their slack and press on each other from frame ~10 and swing for
 // ever; docking's ship (zero gravity) meets the slot's floor at frame ~685; carrier_fleet's crates hit the
