@@ -25,7 +25,7 @@ bool World::canCollide(uint32_t a, uint32_t b) const {
   return bodies_.inverseMass[a] > 0.f || bodies_.inverseMass[b] > 0.f;
 }
 
-WorldAabb World::boundsOf(uint32_t i, float& reach) const {
+World::BoxNow World::boxNow(uint32_t i) const {
   const RigidTransform pose = bodies_.shapePose(i);
   const Mat3f R = pose.rotation.toRotationMatrix().cwiseAbs();
   Vec3d centre, half;
@@ -46,13 +46,33 @@ WorldAabb World::boundsOf(uint32_t i, float& reach) const {
     centre = pose.translation;
     half = (R * bodies_.shape[i].primitive.localHalfExtents()).cast<double>();
   }
+  return {centre, half, (centre - bodies_.position[i]).norm() + half.norm()};
+}
+
+WorldAabb World::BoxNow::grown(double reach, double timestep) const {
+  // A margin of how far the body can move this frame keeps fast bodies in their pairs.
+  const double margin = tuning::kBroadphaseMargin + reach * timestep;
+  return {centre - half - Vec3d::Constant(margin), centre + half + Vec3d::Constant(margin)};
+}
+
+WorldAabb World::boundsOf(uint32_t i, float& reach) const {
+  const BoxNow now = boxNow(i);
   // How far any point of the body can move per second: its speed plus its spin times its
   // radius about the centre of mass (a spinning capsule's ends outrun its centre).
-  const double radius = (centre - bodies_.position[i]).norm() + half.norm();
-  reach = float(double(bodies_.linearVelocity[i].norm()) + double(bodies_.angularVelocity[i].norm()) * radius);
-  // A margin of how far the body can move this frame keeps fast bodies in their pairs.
-  const double margin = tuning::kBroadphaseMargin + double(reach) * scene_.settings.timestep;
-  return {centre - half - Vec3d::Constant(margin), centre + half + Vec3d::Constant(margin)};
+  reach = float(double(bodies_.linearVelocity[i].norm()) + double(bodies_.angularVelocity[i].norm()) * now.radius);
+  return now.grown(double(reach), scene_.settings.timestep);
+}
+
+WorldAabb World::boundsMovingBeside(uint32_t i, uint32_t carrier) const {
+  float reach;
+  if (!bodies_.translates(carrier) && !bodies_.turns(carrier)) return boundsOf(i, reach);
+  const BoxNow now = boxNow(i);
+  // The carrier's velocity at the body's centre, and how far it varies over the body's extent.
+  const Vec3f w = bodies_.movingAngular(carrier);
+  const Vec3f v = bodies_.movingLinear(carrier) + w.cross((now.centre - bodies_.position[carrier]).cast<float>());
+  const double relative = double((bodies_.movingLinear(i) - v).norm()) + double(bodies_.movingAngular(i).norm()) * now.radius +
+                          double(w.norm()) * now.half.norm();
+  return now.grown(relative, scene_.settings.timestep);
 }
 
 WorldAabb World::broadphaseBounds(uint32_t body) const {

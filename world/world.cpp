@@ -295,8 +295,12 @@ void World::applyGridEdits() {
       const uint32_t g = side.first, other = side.second;  // note: not a structured binding (clang 14 cannot capture one)
       if (!bodies_.shape[g].isGrid() || !edited[bodies_.shape[g].grid]) continue;
       if (edited[bodies_.shape[g].grid] == 2) return true;
+      // note: how `other` moves relative to the edited grid: a crate riding a flying ship wakes for
+      // a brick taken from under it, not for one its world-frame sweep (4 m/s) passes.
       float reach;
-      const WorldAabb box = other < hasEditBounds_.size() && hasEditBounds_[other] ? editBounds_[other] : boundsOf(other, reach);
+      const WorldAabb box = bodies_.translates(g) || bodies_.turns(g) ? boundsMovingBeside(other, g)
+                            : other < hasEditBounds_.size() && hasEditBounds_[other] ? editBounds_[other]
+                                                                                     : boundsOf(other, reach);
       if (editedBoxes_.any(box, [&](uint32_t holder) { return holder == g; })) return true;
     }
     return false;

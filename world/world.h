@@ -292,6 +292,16 @@ class World {
   /// Gravity (velocity += gravityDt) on awake dynamic bodies, then every body's bounds; parallel.
   void computeBounds(const Vec3f& gravityDt, int stage);
   WorldAabb boundsOf(uint32_t body, float& reach) const;
+  /// The body's box as boundsOf() grows it, but for its motion relative to `carrier` (the
+  /// carrier's velocity at the body taken off; boundsOf() when the carrier does not move): a
+  /// crate riding a flying deck moves nowhere near the deck's bricks.
+  WorldAabb boundsMovingBeside(uint32_t body, uint32_t carrier) const;
+  struct BoxNow {
+    Vec3d centre, half;
+    double radius;  // from the centre of mass to the farthest corner
+    WorldAabb grown(double reach, double timestep) const;
+  };
+  BoxNow boxNow(uint32_t body) const;
   // The broadphase over proxies (broadphase_proxies.cpp): pairs_ from bounds_.
   void findPairs();
   void generateContacts(float dt);
