@@ -2,18 +2,24 @@
 // median/p95 frame time, total time, measured speedup over 1 thread, the state hash (must be
 // identical), and, from the 1-thread run's per-job timings, the work, span and the speedup they
 // bound at 2, 4, 8 and 16 threads, so a small machine still says how the frame would scale.
+// Around each run it times a cache line's hand-over between two threads (jobs/core_handover.h):
+// on a VM it moves from run to run with where the host put the vCPUs, and the measured speedup
+// of the fine-grained stages with it.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <thread>
 
 #include "cli/command_registry.h"
 #include "cli/output_check.h"
 #include "cli/render_figures.h"
 #include "cli/scene_run.h"
+#include "jobs/core_handover.h"
 #include "world/scene_file.h"
 #include "world/world.h"
 
@@ -35,9 +41,15 @@ struct SweepRow {
   }
   RenderFigures render;  // scenes with attachments
   bool hasRender = false;
+  CoreHandover handoverBefore, handoverAfter;  // timed just before and just after the run
 };
 
+nlohmann::json handoverJson(const CoreHandover& h) { return h.measured ? nlohmann::json(h.medianNs) : nlohmann::json(nullptr); }
+std::string handoverText(const CoreHandover& h) { return h.measured ? std::to_string(int(std::lround(h.medianNs))) : "-"; }
+
 SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames, SubmissionMode mode) {
+  // note: before the world exists: its render thread's start-up would share a core with the timing.
+  const CoreHandover before = measureCoreHandover();
   World world(scene, threads, mode);
   std::vector<double> t;
   RenderFigures render;
@@ -47,7 +59,8 @@ SweepRow runAt(const SceneDescription& scene, int threads, uint32_t frames, Subm
     t.push_back(world.lastStats().totalMs);
     if (world.render()) render.add(world.lastStats());
   }
-  SweepRow r{threads, 0, 0, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), world.stateHash(), 0, 0, 0, {}, {}, false};
+  SweepRow r{threads, 0, 0, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), world.stateHash(), 0, 0, 0, {}, {}, false, before, {}};
+  r.handoverAfter = measureCoreHandover();
   std::sort(t.begin(), t.end());
   r.medianMs = t[t.size() / 2];
   r.p95Ms = t[std::min(t.size() - 1, size_t(double(t.size()) * 0.95))];
@@ -110,16 +123,19 @@ CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured
     if (!csv->empty()) {
       std::ofstream out(*csv);
       if (!out) throw std::runtime_error("cannot write " + *csv);
-      out << "scene,threads,frames,median_ms,p95_ms,total_s,measured_speedup,bound_speedup,state_hash\n";
+      out << "scene,threads,frames,median_ms,p95_ms,total_s,measured_speedup,bound_speedup,state_hash,handover_before_ns,handover_after_ns\n";
       for (const SweepRow& r : rows)
         out << desc.name << "," << r.threads << "," << n << "," << r.medianMs << "," << r.p95Ms << "," << r.totalS << ","
-            << one.totalS / r.totalS << "," << one.speedupBound(r.threads) << "," << r.hash << "\n";
+            << one.totalS / r.totalS << "," << one.speedupBound(r.threads) << "," << r.hash << ","
+            << (r.handoverBefore.measured ? std::to_string(r.handoverBefore.medianNs) : "") << ","
+            << (r.handoverAfter.measured ? std::to_string(r.handoverAfter.medianNs) : "") << "\n";
     }
     if (*json) {
       nlohmann::json j{{"scene", desc.name}, {"frames", n}, {"state_hash_identical", sameHash}};
       for (const SweepRow& r : rows)
         j["runs"].push_back({{"threads", r.threads}, {"median_ms", r.medianMs}, {"p95_ms", r.p95Ms}, {"total_s", r.totalS},
-                             {"measured_speedup", one.totalS / r.totalS}, {"state_hash", r.hash}});
+                             {"measured_speedup", one.totalS / r.totalS}, {"state_hash", r.hash},
+                             {"core_handover_ns", {{"before", handoverJson(r.handoverBefore)}, {"after", handoverJson(r.handoverAfter)}}}});
       for (int p : {2, 4, 8, 16}) j["bound_speedup"][std::to_string(p)] = one.speedupBound(p);
       j["work_ms"] = one.workMs;
       j["span_ms"] = one.spanMs;
@@ -147,10 +163,14 @@ CommandRegistration reg{"sweep", "Run a scene at several thread counts: measured
       return sameHash ? 0 : 3;
     }
     std::printf("sweep %s: %u frames per run\n", desc.name.c_str(), n);
-    std::printf("  %-8s %10s %10s %9s %9s %9s  %s\n", "threads", "median", "p95", "total", "measured", "bound", "state hash");
+    std::printf("  %-8s %10s %10s %9s %9s %9s  %-16s  %s\n", "threads", "median", "p95", "total", "measured", "bound", "state hash",
+                "hand-over ns");
     for (const SweepRow& r : rows)
-      std::printf("  %-8d %7.3f ms %7.3f ms %7.2f s %8.2fx %8.2fx  %016llx\n", r.threads, r.medianMs, r.p95Ms, r.totalS,
-                  one.totalS / r.totalS, one.speedupBound(r.threads), (unsigned long long)r.hash);
+      std::printf("  %-8d %7.3f ms %7.3f ms %7.2f s %8.2fx %8.2fx  %016llx  %s / %s\n", r.threads, r.medianMs, r.p95Ms, r.totalS,
+                  one.totalS / r.totalS, one.speedupBound(r.threads), (unsigned long long)r.hash, handoverText(r.handoverBefore).c_str(),
+                  handoverText(r.handoverAfter).c_str());
+    std::printf("  hand-over: a cache line from one thread to another, median ns, before / after each run (threads placed by\n"
+                "  the OS; on a VM it follows where the host put the vCPUs, and the waves of the coloured solve with it)\n");
     std::printf("  from the 1-thread run: work %.1f ms, span %.1f ms (%.1f ms of it serial between stages, outside any zone);\n"
                 "  speedup bound at 2/4/8/16 threads: %.2fx %.2fx %.2fx %.2fx\n",
                 one.workMs, one.spanMs, one.glueMs, one.speedupBound(2), one.speedupBound(4), one.speedupBound(8),
