@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <sched.h>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -14,8 +15,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The ball and the stop flag on lines of their own: the flag is read by the spinning partner,
-// and a write to the ball's line is the one thing being timed.
+// Each value on a line of its own: the flags are read by the spinning partner (and stay in its
+// cache), and a write to the ball's line is the one thing being timed.
 struct alignas(64) Line {
   std::atomic<uint64_t> value{0};
 };

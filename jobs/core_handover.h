@@ -8,7 +8,7 @@
 /// Why a scaling run reports it: stages that pass work between threads every few microseconds
 /// (the coloured solve's waves hand their bodies from core to core) slow down with it, and on a
 /// VM it is not a property of the machine but of where the host placed the vCPUs at the time.
-/// On this project's 2-vCPU host it ranged 25-100 ns from one process to the next, and
+/// On this project's 2-vCPU host it ranged 25-240 ns from one process to the next, and
 /// crate_pile's 2-thread solver took 1.2-1.5 ms a frame in some runs and 2.8-3.2 ms in others
 /// of the same binary (profiles/RESULTS.md, session 49): a measured speedup is read beside it.
 /// The threads are placed by the OS (not pinned): the figure is for the pair it chose.

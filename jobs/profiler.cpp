@@ -128,9 +128,13 @@ void Profiler::clear() {
   }
 }
 
-double WorkSpan::boundMs(int threads) const {
+double WorkSpan::boundMs(int threads) const { return boundMsWithHandOvers(threads, 0.0); }
+
+double WorkSpan::boundMsWithHandOvers(int threads, double handOverMs) const {
+  const double charge = threads > 1 ? 2.0 * handOverMs : 0.0;  // one thread hands nothing over
   double t = glueMs;
-  for (size_t s = 0; s < stageWorkMs.size(); ++s) t += std::max(stageWorkMs[s] / threads, stageSpanMs[s]);
+  for (size_t s = 0; s < stageWorkMs.size(); ++s)
+    t += std::max(stageWorkMs[s] / threads, stageSpanMs[s]) + (stageWorkMs[s] > stageSpanMs[s] ? charge : 0.0);
   return std::max({t, workMs / threads, besideSpanMs});
 }
 

@@ -67,6 +67,13 @@ struct WorkSpan {
   /// max(work / p, longest job), plus the glue; or all the work over p, or the longest beside zone.
   double boundMs(int threads) const;
   double speedupBound(int threads) const;  ///< workMs / boundMs(p)
+  /// boundMs(threads) with every stage of several jobs (work above its longest job) charged two
+  /// hand-overs of `handOverMs` with more than one thread: its jobs reach the other threads
+  /// through a cache line, and its end reaches the next stage through another. The plain bound
+  /// charges nothing for them, and a frame of ~60 stages of a few microseconds pays them whole
+  /// (monument ran slower on two threads than on one with 160-ns hand-overs; profiles/RESULTS.md
+  /// session 49). One thread hands nothing over: boundMs(1).
+  double boundMsWithHandOvers(int threads, double handOverMs) const;
   std::vector<double> stageWorkMs, stageSpanMs;
   std::vector<int32_t> stageIds;  ///< the stage id of each entry above, ascending
 };

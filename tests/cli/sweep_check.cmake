@@ -1,6 +1,7 @@
 # `brickworld sweep --json` as a thread-scaling user reads it: every run reports its state hash
 # (identical across thread counts) and the cache-line hand-over timed just before and after it
-# (a number of nanoseconds, or null where it could not be timed), beside its measured speedup.
+# (a number of nanoseconds, or null where it could not be timed), beside its measured speedup,
+# and the bound charged for those hand-overs.
 execute_process(COMMAND ${BRICKWORLD} sweep stack10 --threads 1,2 --frames 5 --json
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
 if(NOT rc EQUAL 0)
@@ -30,3 +31,17 @@ foreach(i RANGE 1)
     message(STATUS "sweep: ${threads} threads, measured ${speedup}x, hand-over ${when} ${ns} ns")
   endforeach()
 endforeach()
+# With a hand-over timed, the bound charged for them: never above the plain bound.
+string(JSON charged ERROR_VARIABLE chargeError GET "${out}" handover_ns_charged)
+if(chargeError STREQUAL "NOTFOUND")
+  foreach(p 2 4 8 16)
+    string(JSON plain GET "${out}" bound_speedup ${p})
+    string(JSON with GET "${out}" bound_speedup_with_handovers ${p})
+    message(STATUS "sweep: bound at ${p} threads ${plain}x, with ${charged}-ns hand-overs ${with}x")
+    if(with GREATER plain OR NOT with GREATER 0)
+      message(FATAL_ERROR "sweep: bound at ${p} threads with hand-overs ${with}x against ${plain}x without")
+    endif()
+  endforeach()
+else()
+  message(STATUS "sweep: no hand-over could be timed (${chargeError})")
+endif()

@@ -40,7 +40,9 @@ TEST(CoreHandover, MeasuresEveryBatchWithinItsLimit) {
     h = measureCoreHandover(kBatches, kTrips, kLimitMs);
     apart = apart || ranApart(h);
     // Unmeasured yet run apart: only kMaxStalledBatches stalls may end a measurement.
-    if (!h.measured && ranApart(h)) EXPECT_EQ(h.stalledBatches, kMaxStalledBatches);
+    if (!h.measured && ranApart(h)) {
+      EXPECT_EQ(h.stalledBatches, kMaxStalledBatches);
+    }
   }
   if (!apart) GTEST_SKIP() << "the two threads never ran on different CPUs (a busy machine)";
   ASSERT_TRUE(h.measured);

@@ -35,6 +35,24 @@ TEST(Profiler, WorkSpanAndSpeedupBoundsFromStageStructure) {
   EXPECT_EQ(p.workSpan(4).workMs, 0.0) << "other frames are separate";
 }
 
+TEST(Profiler, TheBoundWithHandOversChargesOnlyStagesOfSeveralJobs) {
+  Profiler p;
+  p.beginFrame(0);
+  const int64_t ms = 1'000'000;
+  // Stage 0: four 2 ms jobs (a fork and a join); stage 1: one 1 ms job (nothing handed over);
+  // stage 2: three 1 ms pushes under one lock (serial: work = span, run where they are).
+  for (int i = 0; i < 4; ++i) p.record("job", i * 2 * ms, (i + 1) * 2 * ms, 0);
+  p.record("one", 8 * ms, 9 * ms, 1);
+  for (int i = 0; i < 3; ++i) p.record("push", (9 + i) * ms, (10 + i) * ms, 2, /*serial*/ true);
+  const WorkSpan ws = p.workSpan(0);
+  ASSERT_EQ(ws.stages, 3);
+  const double h = 0.25;
+  EXPECT_DOUBLE_EQ(ws.boundMsWithHandOvers(1, h), ws.boundMs(1));
+  EXPECT_DOUBLE_EQ(ws.boundMsWithHandOvers(2, h), 4.0 + 2 * h + 1.0 + 3.0);
+  EXPECT_DOUBLE_EQ(ws.boundMsWithHandOvers(16, h), 2.0 + 2 * h + 1.0 + 3.0);
+  EXPECT_DOUBLE_EQ(ws.boundMsWithHandOvers(16, 0.0), ws.boundMs(16));
+}
+
 TEST(Profiler, SerialZonesCountWholeInTheSpan) {
   // Eight 1 ms pushes under one lock from eight jobs: however many threads, they take 8 ms.
   Profiler p;
