@@ -57,10 +57,17 @@ CoreHandover measureCoreHandover(uint32_t batches, uint32_t roundTrips, double b
     }
   });
   uint64_t value = 0;
-  const auto handOver = [&] {
+  // One round trip. With a deadline, a long wait past it says so (true); the answer is still
+  // awaited, so the next round trip starts with the ball here.
+  const auto roundTrip = [&](const Clock::time_point* deadline) {
     ball.value.store(value + 1, std::memory_order_release);
     value += 2;
-    for (uint32_t spins = 0; ball.value.load(std::memory_order_acquire) != value; ++spins) relax(spins);
+    bool late = false;
+    for (uint32_t spins = 0; ball.value.load(std::memory_order_acquire) != value; ++spins) {
+      if (deadline && !late && spins % 1024 == 1023 && Clock::now() > *deadline) late = true;
+      relax(spins);
+    }
+    return late;
   };
   // A new thread often starts on its creator's core and is moved by the OS only later (the first
   // measurement in a process stalled three batches in a row here): hand over, yielding now and
@@ -72,27 +79,22 @@ CoreHandover measureCoreHandover(uint32_t batches, uint32_t roundTrips, double b
       partner.join();
       return result;
     }
-    handOver();
+    roundTrip(nullptr);
     const int cpu = sched_getcpu();  // -1 where the OS cannot say: then the timing is taken as it comes
     const bool differ = cpu < 0 || partnerCpu.value.load(std::memory_order_relaxed) != uint64_t(int64_t(cpu));
     apart = differ ? apart + 1 : 0;
     if (!differ) std::this_thread::yield();
   }
   warming.value.store(0, std::memory_order_relaxed);  // seen by the partner's next answers at the latest
-  const auto limit = std::chrono::duration<double, std::milli>(batchLimitMs);
+  const auto limit = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::milli>(batchLimitMs));
   std::vector<double> ns;
   for (uint32_t b = 0; b < batches && result.stalledBatches < kMaxStalledBatches; ++b) {
     const auto start = Clock::now();
+    const auto deadline = start + limit;
     bool over = false;
     for (uint32_t i = 0; i < roundTrips && !over; ++i) {
-      ball.value.store(value + 1, std::memory_order_release);
-      value += 2;
-      // note: an abandoned batch still waits for this answer, so the next starts with the ball here.
-      for (uint32_t spins = 0; ball.value.load(std::memory_order_acquire) != value; ++spins) {
-        if (!over && spins % 1024 == 1023 && Clock::now() - start > limit) over = true;
-        relax(spins);
-      }
-      if (i % 64 == 63 && Clock::now() - start > limit) over = true;
+      over = roundTrip(&deadline);
+      if (i % 64 == 63 && Clock::now() > deadline) over = true;
     }
     if (over) ++result.stalledBatches;
     else ns.push_back(std::chrono::duration<double, std::nano>(Clock::now() - start).count() / (2.0 * roundTrips));
