@@ -398,31 +398,36 @@ void World::makeBodyOfPart(uint32_t g, const std::vector<uint32_t>& part) {
   if (recordingEdits_)
     for (uint32_t id : part) editLog_.bricks.push_back({g, id, false, old.brick(id)});
   const std::vector<uint32_t> lamps = lightsOnPart(g, part);  // before the part's bricks leave
-  BrickGrid::Move move = old.prepareMove(part, *grid);
+  BrickGrid::Move move = old.beginMove(part, *grid);
   const std::vector<uint32_t>& ids = move.newIds();
   std::unique_ptr<BrickConnectivity> partLinks;
-  // The part's index build, its bricks and mass, the old grid's bulk removal, its bricks and
-  // mass, and the links' move touch five separate things: on two threads a big part costs about
-  // its build (Split_CutInTwo, 50k bricks: 17 -> 12 ms). note: tried before the removal gave its
+  // The gather reads the old grid and writes each brick's new slot and entry once: in chunks at
+  // once (it was 1.4 ms of serial time in a 50k-brick cut, with the part's bricks' first-touch
+  // faults now in it). Then the part's index build, its mass, the old grid's bulk removal, its
+  // bricks and mass, and the links' move touch five separate things. Their order splits them
+  // between two threads by cost (oneTBB halves [0, 5) and the second thread takes [2, 5)): the
+  // build with the old grid's bricks (Split_CutInTwo, 50k bricks, one thread: 3.9 + 0.5 ms)
+  // beside the bulk removal, the part's mass and the links (2.4 + 0.8 + 1.2 ms); with four
+  // threads or more the build alone is the longest. note: tried before the removal gave its
   // emptied pages back in runs (PoolIndexSpace::DeferPageRelease), this was slower than one
   // thread: a madvise per emptied block, each flushing the TLB of the core that was building.
-  // The build goes first and the part's bricks and mass second: oneTBB's halves give one thread
-  // both (29 + 15 M instructions for a 50k-brick half) while the other takes the old grid's two
-  // (22 + 3 M: the part's moments are summed once, by the part) and the links (9 M); with four
-  // threads or more the build alone is the longest.
   constexpr uint32_t kSteps = 5;
   const auto step = [&](uint32_t k) {
     if (k == 0) grid->receiveMoveIndex(move);
-    else if (k == 1) grid->receiveMoveBricks(move);
+    else if (k == 1) old.releaseMoveBricks(move);
     else if (k == 2) old.releaseMoveIndex(move);
-    else if (k == 3) old.releaseMoveBricks(move);
+    else if (k == 3) grid->receiveMoveBricks(move);
     else partLinks = std::make_unique<BrickConnectivity>(*links_[g], part, ids);  // the old links, renumbered
   };
-  if (part.size() >= tuning::kParallelPartBricks) {
+  const uint32_t n = uint32_t(part.size());
+  if (n >= tuning::kParallelPartBricks) {
+    jobs_.parallelFor(0, n, tuning::grainFor(n, tuning::kMinGatherGrain),
+                      [&](uint32_t begin, uint32_t end) { old.gatherMove(move, begin, end); });
     jobs_.parallelFor(0, kSteps, 1, [&](uint32_t begin, uint32_t end) {
       for (uint32_t k = begin; k < end; ++k) step(k);
     });
   } else {
+    old.gatherMove(move, 0, n);
     for (uint32_t k = 0; k < kSteps; ++k) step(k);
   }
   if (renderChunks_)  // the bricks as they were, now in the part's grid

@@ -160,6 +160,9 @@ inline constexpr uint32_t kRayGrain = 64;
 /// bricks go on another (World::makeBodyOfPart): each half then costs milliseconds, against the
 /// few microseconds of waking a thread; below it the three steps run in turn.
 inline constexpr uint32_t kParallelPartBricks = 2048;
+/// Fewest bricks per job of a part's gather (World::makeBodyOfPart: a brick, its bounds and its
+/// element read, each a cache miss asked for ahead).
+inline constexpr uint32_t kMinGatherGrain = 1024;
 
 // --- Sleeping -----------------------------------------------------------------------------
 /// An island whose bodies all stayed below these speeds (m/s, rad/s) for kSleepTime (s) sleeps.

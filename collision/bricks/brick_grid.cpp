@@ -77,28 +77,38 @@ std::vector<uint32_t> BrickGrid::placeValidBricks(const std::vector<Brick>& bric
   return ids;
 }
 
-void BrickGrid::indexValidBricksOrFree(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
-                                       bool boundsFromIndex) {
+void BrickGrid::indexValidBricksOrFree(const std::vector<uint32_t>& ids, std::span<const Brick> bricks, std::span<const Aabb> bounds) {
+  std::vector<uint32_t> filters;
+  filters.reserve(bricks.size());
+  for (const Brick& b : bricks) filters.push_back(b.filter);
   try {
-    indexValidBricks(ids, bricks, bounds, boundsFromIndex);
+    // (bulkLoad validates every box before building: the range of a brick's bounds is checked there)
+    indexValidBricks(ids, bounds, filters, false);
   } catch (...) {
     for (uint32_t id : ids) bricks_.free(id);
     throw;
   }
 }
 
-void BrickGrid::indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
+void BrickGrid::indexMovedBricksOrFree(const Move& m) {
+  try {
+    indexMovedBricks(m);
+  } catch (...) {
+    for (uint32_t id : m.newIds_) bricks_.free(id);
+    throw;
+  }
+}
+
+void BrickGrid::indexMovedBricks(const Move& m) { indexValidBricks(m.newIds_, m.bounds_, m.filters_, true); }
+
+void BrickGrid::indexValidBricks(const std::vector<uint32_t>& ids, std::span<const Aabb> bounds, std::span<const uint32_t> filters,
                                  bool boundsFromIndex) {
-  std::vector<uint32_t> filters;
-  filters.reserve(bricks.size());
-  for (const Brick& b : bricks) filters.push_back(b.filter);
-  // (bulkLoad validates every box before building: the range of a brick's bounds is checked there)
   const std::vector<uint32_t> elements =
       boundsFromIndex ? index_.bulkLoadValid(bounds, filters, ids) : index_.bulkLoad(bounds, filters, ids);
   for (size_t i = 0; i < ids.size(); ++i) bricks_.get<1>(ids[i]) = elements[i];
 }
 
-void BrickGrid::addValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks) {
+void BrickGrid::addValidBricks(const std::vector<uint32_t>& ids, std::span<const Brick> bricks) {
   for (size_t i = 0; i < bricks.size(); ++i) {
     bricks_.get<0>(ids[i]) = bricks[i];
     if (!referenceSet_) {
@@ -121,6 +131,12 @@ std::vector<uint32_t> BrickGrid::moveBricks(std::span<const uint32_t> ids, Brick
 }
 
 BrickGrid::Move BrickGrid::prepareMove(std::span<const uint32_t> ids, BrickGrid& into) {
+  Move m = beginMove(ids, into);
+  gatherMove(m, 0, m.size());
+  return m;
+}
+
+BrickGrid::Move BrickGrid::beginMove(std::span<const uint32_t> ids, BrickGrid& into) {
   const char* context = "BrickGrid::moveBricks";
   if (&into == this) throw InvalidInput(std::string(context) + ": a grid cannot move bricks into itself");
   if (into.bricks_.size() != 0)
@@ -138,41 +154,49 @@ BrickGrid::Move BrickGrid::prepareMove(std::span<const uint32_t> ids, BrickGrid&
   m.from_ = this;
   m.into_ = &into;
   m.ids_.assign(ids.begin(), ids.end());
-  m.bricks_.reserve(ids.size());
-  m.bounds_.reserve(ids.size());
-  m.elements_.reserve(ids.size());
-  // note: the ids come in a search's order, so each brick and its index record is a cache miss;
-  // asked for ahead (the record half as far ahead as its brick, whose element handle names it),
-  // the gather of a 50k-brick part took 3.5 -> 1.9 ms (perf samples).
-  constexpr size_t kAhead = 16;
-  for (size_t i = 0; i < ids.size(); ++i) {
-    if (i + 2 * kAhead < ids.size()) {
-      __builtin_prefetch(&bricks_.get<0>(ids[i + 2 * kAhead]));
-      __builtin_prefetch(&bricks_.get<1>(ids[i + 2 * kAhead]));
-    }
-    if (i + kAhead < ids.size()) index_.prefetchElement(bricks_.get<1>(ids[i + kAhead]));
-    const uint32_t id = ids[i];
-    m.bricks_.push_back(bricks_.get<0>(id));
-    const uint32_t e = bricks_.get<1>(id);
-    m.bounds_.push_back(index_.bounds(e));  // the brick's bounds as indexed (brickBounds of it)
-    m.elements_.push_back(e);
-  }
+  resizeForOverwrite(m.bounds_, ids.size());
+  resizeForOverwrite(m.elements_, ids.size());
+  resizeForOverwrite(m.filters_, ids.size());
   m.newIds_.resize(ids.size());
-  into.bricks_.allocateMany(uint32_t(ids.size()), m.newIds_.data());
+  // (gatherMove writes every brick and receiveMoveIndex every element: left unconstructed)
+  into.bricks_.allocateManyForOverwrite(uint32_t(ids.size()), m.newIds_.data());
   m.fromEdits_ = edits_;
   m.reference_ = reference_;
   return m;
 }
 
+void BrickGrid::gatherMove(Move& m, size_t begin, size_t end) const {
+  BW_ASSERT(m.from_ == this && begin <= end && end <= m.size());
+  const std::vector<uint32_t>& ids = m.ids_;
+  // note: the ids come in a search's order, so each brick and its index record is a cache miss;
+  // asked for ahead (the record half as far ahead as its brick, whose element handle names it),
+  // the gather of a 50k-brick part took 3.5 -> 1.9 ms (perf samples).
+  constexpr size_t kAhead = 16;
+  for (size_t i = begin; i < end; ++i) {
+    if (i + 2 * kAhead < end) {
+      __builtin_prefetch(&bricks_.get<0>(ids[i + 2 * kAhead]));
+      __builtin_prefetch(&bricks_.get<1>(ids[i + 2 * kAhead]));
+    }
+    if (i + kAhead < end) index_.prefetchElement(bricks_.get<1>(ids[i + kAhead]));
+    const uint32_t id = ids[i];
+    const Brick& b = bricks_.get<0>(id);
+    m.into_->bricks_.get<0>(m.newIds_[i]) = b;  // straight to its slot there (nothing else writes it)
+    const uint32_t e = bricks_.get<1>(id);
+    m.bounds_[i] = index_.bounds(e);  // the brick's bounds as indexed (brickBounds of it)
+    m.elements_[i] = e;
+    m.filters_[i] = b.filter;
+  }
+}
+
 void BrickGrid::receiveMove(Move& m) {
   BW_ASSERT(m.into_ == this);
-  indexValidBricksOrFree(m.newIds_, m.bricks_, m.bounds_, true);
+  indexMovedBricksOrFree(m);
   receiveMoveBricks(m);
 }
 
 void BrickGrid::receiveMoveIndex(Move& m) {
   BW_ASSERT(m.into_ == this);
-  indexValidBricks(m.newIds_, m.bricks_, m.bounds_, true);
+  indexMovedBricks(m);
 }
 
 // note: the moved bricks' moments are taken about the old grid's reference, so the one sum
@@ -182,11 +206,17 @@ void BrickGrid::receiveMoveBricks(Move& m) {
   BW_ASSERT(m.into_ == this);
   // (this grid was empty: prepareMove checked) Its reference is the old grid's, so the sum
   // addValidBricks makes here is the part's sum about it.
-  if (!m.bricks_.empty()) {
+  if (!m.newIds_.empty()) {
     reference_ = m.reference_;
     referenceSet_ = true;
   }
-  addValidBricks(m.newIds_, m.bricks_);
+  // The bricks are in place (gatherMove wrote them): their moments, in the ids' order.
+  for (const uint32_t id : m.newIds_) {
+    const Brick& b = bricks_.get<0>(id);
+    moments_.add(brickMoments(b, config_.density[b.material], reference_));
+  }
+  peakSecond_ = std::max(peakSecond_, moments_.value().second.trace());
+  ++edits_;
   m.moments_ = moments_;
   rebaseIfCancelling();  // a small part far from the old grid's reference point
   finishMoveMassStep(m);

@@ -23,6 +23,7 @@
 #include "collision/bricks/contact.h"
 #include "collision/bricks/grid_pair.h"
 #include "collision/core/ids.h"
+#include "collision/core/overwrite_vector.h"
 #include "collision/core/rigid_transform.h"
 #include "collision/index/octobvh.h"
 
@@ -148,24 +149,38 @@ class BrickGrid {
   /// current once both have run). The grid the bricks leave must not be edited between
   /// prepareMove and its release: releaseMove (before either step) and
   /// releaseMoveBricks refuse with InvalidInput if it was, or if the move was released already.
+  /// prepareMove is itself beginMove (the checks and the new ids) and gatherMove over every
+  /// entry, which a caller with threads may split into ranges gathered at once.
   class Move {
    public:
-    /// The bricks' ids in `into`, in the order of the ids moved (known once prepared).
+    /// The bricks' ids in `into`, in the order of the ids moved (known once begun).
     const std::vector<uint32_t>& newIds() const { return newIds_; }
+    /// Bricks moved.
+    size_t size() const { return ids_.size(); }
 
    private:
     friend class BrickGrid;
     BrickGrid* from_ = nullptr;
     BrickGrid* into_ = nullptr;
-    std::vector<uint32_t> ids_, newIds_, elements_;
-    std::vector<Brick> bricks_;
-    std::vector<Aabb> bounds_;
+    std::vector<uint32_t> ids_, newIds_;
+    // Sized by beginMove and written whole by gatherMove's ranges (which write the bricks into
+    // their new slots directly): their pages are first touched by the threads that gather
+    // (collision/core/overwrite_vector.h).
+    OverwriteVector<uint32_t> elements_, filters_;
+    OverwriteVector<Aabb> bounds_;
     uint64_t fromEdits_ = 0;  // from_'s edit count when prepared: releaseMoveBricks trusts the ids while it holds
     Vec3d reference_ = Vec3d::Zero();  // from_'s reference point when prepared (into's from then on)
     MomentSum moments_;       // the moved bricks' moments about it (receiveMoveBricks)
     uint32_t massSteps_ = 0;  // receiveMoveBricks and releaseMoveBricks done (atomic_ref: they may run at once)
   };
   Move prepareMove(std::span<const uint32_t> ids, BrickGrid& into);
+  /// prepareMove's checks, the ids allocated in `into` and the move's arrays sized (not filled):
+  /// gatherMove must then fill every entry before the move is received or released.
+  Move beginMove(std::span<const uint32_t> ids, BrickGrid& into);
+  /// Fills entries [begin, end) of a begun move: each brick copied to its new slot in `into`,
+  /// its bounds as indexed, its element and filter noted. Reads this grid and writes only those
+  /// slots and entries: disjoint ranges may be gathered at the same time.
+  void gatherMove(Move& move, size_t begin, size_t end) const;
   /// Called on the grid the bricks move into: receiveMoveIndex, then receiveMoveBricks.
   void receiveMove(Move& move);
   void receiveMoveIndex(Move& move);
@@ -254,15 +269,19 @@ class BrickGrid {
   /// placeBricks' work once the bricks are known to be valid and the grid empty.
   std::vector<uint32_t> placeValidBricks(const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds);
   /// indexValidBricks for ids allocated already, freeing them again if the build throws.
-  void indexValidBricksOrFree(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
-                              bool boundsFromIndex = false);
+  void indexValidBricksOrFree(const std::vector<uint32_t>& ids, std::span<const Brick> bricks, std::span<const Aabb> bounds);
+  /// The ids allocated for a move freed again if its index build throws.
+  void indexMovedBricksOrFree(const Move& m);
   /// The index's bulk load and each id's element handle (the pool's column 1); throws before
   /// anything changes. boundsFromIndex: the bounds were read from an index (a move), so the
   /// index does not check them again.
-  void indexValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks, const std::vector<Aabb>& bounds,
-                        bool boundsFromIndex = false);
+  void indexValidBricks(const std::vector<uint32_t>& ids, std::span<const Aabb> bounds, std::span<const uint32_t> filters,
+                        bool boundsFromIndex);
+  /// indexValidBricks of a move's gathered bricks: their bounds and filters read from an index
+  /// already, so not checked again.
+  void indexMovedBricks(const Move& m);
   /// The bricks (column 0) and their mass.
-  void addValidBricks(const std::vector<uint32_t>& ids, const std::vector<Brick>& bricks);
+  void addValidBricks(const std::vector<uint32_t>& ids, std::span<const Brick> bricks);
   void rebaseIfCancelling();
   /// Counts one of a move's two mass steps; the second takes the moved bricks' moments out of
   /// the grid they left (after both, so neither step waits for the other).

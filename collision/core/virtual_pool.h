@@ -55,6 +55,14 @@ class ParallelVirtualPool {
     space_.acquireMany(n, out);
     for (uint32_t k = 0; k < n; ++k) constructAll(out[k], std::index_sequence_for<Ts...>{});
   }
+  /// allocateMany leaving the columns unconstructed: for implicit-lifetime columns (aggregates,
+  /// trivially destructible) that the caller writes whole before reading any. A fresh slot's
+  /// pages are then first touched by the thread that writes it, not here (a 50k-brick part's
+  /// bricks: 400 pages, 0.7 ms of serial faults on a VM).
+  void allocateManyForOverwrite(uint32_t n, uint32_t* out) {
+    static_assert(kTrivial, "columns left unconstructed must not need destroying");
+    space_.acquireMany(n, out);
+  }
   /// Destroys the element's columns and frees its slot. Throws InvalidInput if not live.
   void free(uint32_t i) {
     space_.requireLive(i, "free");

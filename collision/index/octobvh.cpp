@@ -445,18 +445,18 @@ int OctoBvh::canonicalRootLevel(const std::vector<uint32_t>& elems) const {
   return scan.level();
 }
 
-std::vector<uint32_t> OctoBvh::bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
-                                        const std::vector<uint32_t>& payloads) {
+std::vector<uint32_t> OctoBvh::bulkLoad(std::span<const Aabb> bounds, std::span<const uint32_t> filters,
+                                        std::span<const uint32_t> payloads) {
   return bulkLoadCheckingBounds(bounds, filters, payloads, true);
 }
 
-std::vector<uint32_t> OctoBvh::bulkLoadValid(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
-                                             const std::vector<uint32_t>& payloads) {
+std::vector<uint32_t> OctoBvh::bulkLoadValid(std::span<const Aabb> bounds, std::span<const uint32_t> filters,
+                                             std::span<const uint32_t> payloads) {
   return bulkLoadCheckingBounds(bounds, filters, payloads, false);
 }
 
-std::vector<uint32_t> OctoBvh::bulkLoadCheckingBounds(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
-                                               const std::vector<uint32_t>& payloads, bool checkBounds) {
+std::vector<uint32_t> OctoBvh::bulkLoadCheckingBounds(std::span<const Aabb> bounds, std::span<const uint32_t> filters,
+                                               std::span<const uint32_t> payloads, bool checkBounds) {
   if (!empty()) throw InvalidInput("OctoBvh::bulkLoad: the tree must be empty");
   if (filters.size() != bounds.size() || payloads.size() != bounds.size())
     throw InvalidInput("OctoBvh::bulkLoad: bounds, filters and payloads differ in length (" +
@@ -470,27 +470,23 @@ std::vector<uint32_t> OctoBvh::bulkLoadCheckingBounds(const std::vector<Aabb>& b
   // neighbouring lines, not one random line per element. The tree is what inserting them gives;
   // inside a node the elements are in the sorted build's order (octobvh_sorted_build.cpp).
   const uint32_t n = uint32_t(bounds.size());
-  std::vector<uint32_t> handles(n);
+  std::vector<uint32_t> handles;
   if (n == 0) return handles;
-  std::vector<BuildItem>& items = buildScratch_;
-  items.resize(n);
   RootLevelScan scan;
-  try {
-    for (uint32_t i = 0; i < n; ++i) {  // one pass over the input: checked and itemised
-      if (checkBounds) validateElement(bounds[i], "OctoBvh::bulkLoad");
-      buildItemOf(ElementRecord::of(bounds[i], 0, 0), i, items[i]);
-      scan.add(items[i].minLevel, items[i].ctr);
-    }
-  } catch (...) {
-    releaseBuildScratch();  // nothing else was touched
-    throw;
+  BuildItem it;
+  for (uint32_t i = 0; i < n; ++i) {  // one pass over the input: checked and scanned (nothing touched yet)
+    if (checkBounds) validateElement(bounds[i], "OctoBvh::bulkLoad");
+    buildItemOf(ElementRecord::of(bounds[i], 0, 0), i, it);
+    scan.add(it.minLevel, it.ctr);
   }
+  handles.resize(n);
   rootLevel_ = scan.level();
   clusters_[rootCluster_].level = int8_t(rootLevel_);
   // The n handles the placements would allocate one by one, in their order, at once (nothing
-  // else allocates elements during the build).
+  // else allocates elements during the build). placeBuilt writes each record whole: the
+  // records are not zeroed first (a pass over 32 bytes an element, its pages' first touch).
   const std::unique_ptr<uint32_t[]> fresh(new uint32_t[n]);  // (written whole: not zeroed first)
-  elements_.allocateMany(n, fresh.get());
+  elements_.allocateManyForOverwrite(n, fresh.get());
   BulkInput input{bounds.data(), filters.data(), payloads.data(), handles.data(), fresh.get(), 0};
   struct BulkScope {  // the build reads bulk_ only while bulkLoad runs
     OctoBvh& tree;
@@ -499,8 +495,8 @@ std::vector<uint32_t> OctoBvh::bulkLoadCheckingBounds(const std::vector<Aabb>& b
   bulk_ = &input;
   // note: one radix sort instead of build()'s partition at every level (the same tree; a 50k
   // brick part's build 46.6 -> 32.6 M instructions, octobvh_sorted_build.cpp).
-  const std::vector<SortedItem> sorted = sortForBuild(items);
-  buildSorted(rootCluster_, 0, rootCube(), 0, sorted.data(), n, items.data());
+  const OverwriteVector<SortedItem> sorted = sortForBuild(bounds);
+  buildSorted(rootCluster_, 0, rootCube(), 0, sorted.data(), n);
   BW_ASSERT(input.placed == n);  // every handle allocated above went to an element
   releaseBuildScratch();
   return handles;

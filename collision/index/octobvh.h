@@ -34,6 +34,7 @@
 
 #include "collision/core/assert.h"
 #include "collision/core/obb.h"
+#include "collision/core/overwrite_vector.h"
 #include "collision/core/ray.h"
 #include "collision/core/virtual_pool.h"
 #include "collision/index/octobvh_layout.h"
@@ -78,12 +79,12 @@ class OctoBvh {
   void update(uint32_t handle, const Aabb& bounds, uint32_t filter);
   /// Builds the tree of the given elements in one pass (same structure as inserting them one
   /// by one). The tree must be empty. Returns the handles in input order.
-  std::vector<uint32_t> bulkLoad(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
-                                 const std::vector<uint32_t>& payloads);
+  std::vector<uint32_t> bulkLoad(std::span<const Aabb> bounds, std::span<const uint32_t> filters,
+                                 std::span<const uint32_t> payloads);
   /// bulkLoad of bounds that already passed an OctoBvh's checks (read back from a tree: a grid's
   /// part moving to a grid of its own), so they are not checked box by box again.
-  std::vector<uint32_t> bulkLoadValid(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
-                                      const std::vector<uint32_t>& payloads);
+  std::vector<uint32_t> bulkLoadValid(std::span<const Aabb> bounds, std::span<const uint32_t> filters,
+                                      std::span<const uint32_t> payloads);
   /// Removes every element.
   void clear();
 
@@ -311,23 +312,20 @@ class OctoBvh {
   void build(uint32_t c, int s, const Cube& cube, BuildItem* items, uint32_t count);
   /// A leaf at the (empty) node (c, s) holding the items, in their order.
   void buildLeaf(uint32_t c, int s, const BuildItem* items, uint32_t count);
-  /// bulkLoad's build (octobvh_sorted_build.cpp): build()'s tree from items sorted once by their
-  /// paths (sortForBuild, with rootLevel_ set), node (c, s) at `depth` below the root. Only
-  /// bulkLoad's items (item i is input i, bulk_ set).
+  /// bulkLoad's build (octobvh_sorted_build.cpp): build()'s tree from its inputs sorted once by
+  /// their paths (sortForBuild, with rootLevel_ set), node (c, s) at `depth` below the root.
+  /// Only during bulkLoad (bulk_ set): an item is an input position.
   struct SortedItem {
     uint64_t key;   ///< the item's path and natural depth (sortedBuildKey)
-    uint32_t item;  ///< its index in the build's items (bulkLoad: its input position)
+    uint32_t item;  ///< its input position
   };
   uint64_t sortedBuildKey(const BuildItem& it) const;
-  /// The items' keys, sorted (by key, then index).
-  std::vector<SortedItem> sortForBuild(const std::vector<BuildItem>& items) const;
-  void buildSorted(uint32_t c, int s, const Cube& cube, int depth, const SortedItem* sorted, uint32_t count,
-                   const BuildItem* items);
-  void buildOctantsSorted(uint32_t sub, const Cube& cube, int depth, const SortedItem* sorted, uint32_t count,
-                          const BuildItem* items);
+  /// The inputs' keys, sorted (by key, then position).
+  OverwriteVector<SortedItem> sortForBuild(std::span<const Aabb> bounds) const;
+  void buildSorted(uint32_t c, int s, const Cube& cube, int depth, const SortedItem* sorted, uint32_t count);
+  void buildOctantsSorted(uint32_t sub, const Cube& cube, int depth, const SortedItem* sorted, uint32_t count);
   /// build()'s subtree of a run of sorted items (where keys cannot order them further).
-  void buildRunUnsorted(uint32_t c, int s, const Cube& cube, const SortedItem* sorted, uint32_t count,
-                        const BuildItem* items, bool octants);
+  void buildRunUnsorted(uint32_t c, int s, const Cube& cube, const SortedItem* sorted, uint32_t count, bool octants);
   void buildOctants(uint32_t sub, const Cube& cube, BuildItem* items, uint32_t count);
   /// Sorts the items by the child cube of `cube` holding their centres (counts and starts per
   /// octant), in place; the order within an octant is the build's (leaves keep it).
@@ -407,8 +405,8 @@ class OctoBvh {
     const uint32_t* fresh;  ///< the handles allocated for the build, taken in placement order
     uint32_t placed;        ///< how many of them are taken
   };
-  std::vector<uint32_t> bulkLoadCheckingBounds(const std::vector<Aabb>& bounds, const std::vector<uint32_t>& filters,
-                                        const std::vector<uint32_t>& payloads, bool checkBounds);
+  std::vector<uint32_t> bulkLoadCheckingBounds(std::span<const Aabb> bounds, std::span<const uint32_t> filters,
+                                        std::span<const uint32_t> payloads, bool checkBounds);
   BulkInput* bulk_ = nullptr;
 };
 

@@ -512,9 +512,11 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
     const std::vector<Brick> bricks = randomBuild(23, 3000, offset);
     // Cuts 0 and 1 by moveBricks; 2 and 3 the same cuts in steps, the old grid letting go
     // before the new one is built (an order World may take on two threads); 4 and 5 in steps,
-    // the new grid taking the bricks first (so each of the two mass steps comes second once).
-    for (int cut = 0; cut < 6; ++cut) {
-      const bool inSteps = cut >= 2, newFirst = cut >= 4;
+    // the new grid taking the bricks first (so each of the two mass steps comes second once);
+    // 6 and 7 begun and gathered in uneven ranges from the back (as the world's jobs may finish),
+    // then the steps in World::makeBodyOfPart's order.
+    for (int cut = 0; cut < 8; ++cut) {
+      const bool inSteps = cut >= 2, newFirst = cut >= 4 && cut < 6, inRanges = cut >= 6;
       BrickGrid grid(config), twin(config);
       std::vector<uint32_t> ids;
       for (const Brick& b : bricks) {
@@ -538,10 +540,24 @@ TEST(BrickGrid, MovingBricksOutEqualsPlacingAndRemovingThemOneByOne) {
       EXPECT_EQ(into.brickCount(), 0u);
       std::vector<uint32_t> moved;
       if (inSteps) {
-        BrickGrid::Move move = grid.prepareMove(part, into);
+        BrickGrid::Move move = inRanges ? grid.beginMove(part, into) : grid.prepareMove(part, into);
         EXPECT_EQ(grid.brickCount(), bricks.size()) << "preparing changes nothing";
+        if (inRanges) {
+          ASSERT_EQ(move.size(), part.size());
+          size_t end = part.size();
+          for (const size_t take : {size_t(1), size_t(7), size_t(100)}) {
+            grid.gatherMove(move, end - take, end);
+            end -= take;
+          }
+          grid.gatherMove(move, 0, end);
+        }
         // The four steps touch separate state (the world runs them at once): any order.
-        if (newFirst) {
+        if (inRanges) {
+          into.receiveMoveIndex(move);
+          grid.releaseMoveBricks(move);
+          grid.releaseMoveIndex(move);
+          into.receiveMoveBricks(move);
+        } else if (newFirst) {
           into.receiveMoveIndex(move);
           into.receiveMoveBricks(move);
           grid.releaseMoveIndex(move);
