@@ -126,8 +126,9 @@ World::RemovalResult World::removeBricks(uint32_t index, std::span<const uint32_
   wholeGridEdits_.push_back(index);
   const StepStats kept = stats_;
   stats_.splits = stats_.debrisBricks = 0;
+  stats_.partBodiesMs = 0;
   splitDetachedParts();
-  RemovalResult r{stats_.splits, stats_.debrisBricks, 0.0};
+  RemovalResult r{stats_.splits, stats_.debrisBricks, 0.0, stats_.partBodiesMs};
   stats_ = kept;  // the last step's figures stay as they were
   if (recordingEdits_) {  // the next step's log starts with these
     betweenSteps_.bricks.insert(betweenSteps_.bricks.end(), editLog_.bricks.begin(), editLog_.bricks.end());

@@ -142,6 +142,7 @@ class World {
     uint32_t parts = 0;         ///< parts split off into dynamic bodies
     uint32_t debrisBricks = 0;  ///< bricks of parts below the grid's debris_bricks, gone
     double ms = 0;              ///< from the first removal to the parts' bodies made
+    double partBodiesMs = 0;    ///< of ms: making the parts' grids and bodies (the rest: removals and the search)
   };
   /// Removes bricks of grid `index` between steps, as a game's demolition does; on a grid that
   /// splits (GridDescription::split) the parts left without a face joint become dynamic bodies

@@ -6,7 +6,9 @@
 //   joined by one brick, split on; World::removeBricks of that brick, timed from the removal to
 //   the detached half's dynamic body made (connectivity search, its grid built in one pass, the
 //   bricks taken out of the old grid, the body added), on a world of 1 or 2 threads (the build
-//   and the removal run at once on two). Counters: parts, detached_bricks.
+//   and the removal run at once on two). Counters: parts, detached_bricks, search_ms (the
+//   removal and the connectivity search), move_ms (the part's grid and body made: gather, index
+//   build, bulk removal, mass, links), means over the cuts.
 // Broadphase/<method>/<n>/iterations:<frames>/manual_time: issue 17's question, which
 // broadphase at 1k, 10k, 100k and 1M bodies. n moving 0.5 m boxes fall onto huge static grids
 // (400 x 400 x 40 m boxes, the shape of the shipped scenes), moved every frame (velocities flip
@@ -628,6 +630,7 @@ void Split_CutInTwo(benchmark::State& state) {
   slab.bricks.push_back(Brick::box(Vec3f(float(side), float(side / 2), 0), Vec3f::Constant(0.5f)));  // the joint, last
   scene.grids = {slab};
   uint32_t parts = 0, detached = 0;
+  double searchMs = 0, moveMs = 0;
   for (auto _ : state) {
     World world(scene, int(state.range(1)));  // each cut needs the slab whole again (not timed)
     const uint32_t joint = uint32_t(slab.bricks.size() - 1);
@@ -637,12 +640,17 @@ void Split_CutInTwo(benchmark::State& state) {
     }
     const World::RemovalResult r = world.removeBricks(0, std::span<const uint32_t>(&joint, 1));
     state.SetIterationTime(r.ms * 1e-3);
+    searchMs += r.ms - r.partBodiesMs;
+    moveMs += r.partBodiesMs;
     parts = r.parts;
     detached = world.bodies().size() > 1 ? world.grid(1).brickCount() : 0;
   }
   state.counters["bricks"] = double(slab.bricks.size());
   state.counters["parts"] = parts;
   state.counters["detached_bricks"] = detached;
+  const double cuts = double(std::max<int64_t>(1, state.iterations()));
+  state.counters["search_ms"] = searchMs / cuts;
+  state.counters["move_ms"] = moveMs / cuts;
 }
 
 }  // namespace

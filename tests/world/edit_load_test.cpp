@@ -467,6 +467,8 @@ TEST(EditLoadSplit, ABigCutIsTheSameOnAnyThreadCountAndConservesMass) {
     }();
     const World::RemovalResult r = world.removeBricks(0, std::span<const uint32_t>(&joint, 1));
     ASSERT_EQ(r.parts, 1u);
+    EXPECT_GT(r.partBodiesMs, 0.0) << "the part's grid and body were timed";
+    EXPECT_LE(r.partBodiesMs, r.ms) << "the part's time is part of the whole";
     ASSERT_EQ(world.gridCount(), 2u);
     EXPECT_EQ(world.grid(0).brickCount(), uint32_t(side * side));
     EXPECT_EQ(world.grid(1).brickCount(), uint32_t(side * side));
@@ -518,6 +520,11 @@ TEST(EditLoadSplit, RemoveBricksSplitsAtOnceAndRefusesBadIdsWhole) {
   EXPECT_THROW(world.removeBricks(0, bad), InvalidInput);
   EXPECT_EQ(world.grid(0).brickCount(), 5u) << "nothing removed";
   EXPECT_THROW(world.removeBricks(3, bad), InvalidInput);
+  const uint32_t end[] = {4};  // splits nothing: no part's time
+  const World::RemovalResult none = world.removeBricks(0, end);
+  EXPECT_EQ(none.parts, 0u);
+  EXPECT_EQ(none.partBodiesMs, 0.0);
+  world.editGrid(0).placeBrick(Brick::box(Vec3f(4, 0, 5), Vec3f::Constant(0.5f)));  // back as it was
   const uint32_t middle[] = {1};  // x = 1: the brick at x = 0 falls off
   const World::RemovalResult r = world.removeBricks(0, middle);
   EXPECT_EQ(r.parts, 1u);
