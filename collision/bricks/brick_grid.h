@@ -141,7 +141,7 @@ class BrickGrid {
   /// state is moveBricks'. Only an allocation failure can stop a step half way.
   /// receiveMove is itself two steps that touch separate state and may run at the same time:
   /// receiveMoveIndex (the index build, and each brick's element) and receiveMoveBricks (the
-  /// bricks and the grid's mass); releaseMove likewise is releaseMoveIndex (the bulk removal)
+  /// grid's mass: the gather put the bricks in their slots); releaseMove likewise is releaseMoveIndex (the bulk removal)
   /// and releaseMoveBricks (the bricks and the mass). The moved bricks' moments are summed once,
   /// by receiveMoveBricks, about this grid's reference point, which `into` takes as its own;
   /// whichever of receiveMoveBricks and releaseMoveBricks finishes second takes that sum out of
