@@ -109,18 +109,13 @@ void BrickGrid::indexValidBricks(const std::vector<uint32_t>& ids, std::span<con
 }
 
 void BrickGrid::addValidBricks(const std::vector<uint32_t>& ids, std::span<const Brick> bricks) {
-  for (size_t i = 0; i < bricks.size(); ++i) bricks_.get<0>(ids[i]) = bricks[i];
-  if (!referenceSet_ && !bricks.empty()) {
-    reference_ = bricks[0].position.cast<double>();  // as placeBrick: moments about the first brick
-    referenceSet_ = true;
-  }
-  addMomentsOf(ids);
-}
-
-void BrickGrid::addMomentsOf(const std::vector<uint32_t>& ids) {
-  for (const uint32_t id : ids) {
-    const Brick& b = bricks_.get<0>(id);
-    moments_.add(brickMoments(b, config_.density[b.material], reference_));
+  for (size_t i = 0; i < bricks.size(); ++i) {
+    bricks_.get<0>(ids[i]) = bricks[i];
+    if (!referenceSet_) {
+      reference_ = bricks[i].position.cast<double>();  // as placeBrick: moments about the first brick
+      referenceSet_ = true;
+    }
+    moments_.add(brickMoments(bricks[i], config_.density[bricks[i].material], reference_));
   }
   peakSecond_ = std::max(peakSecond_, moments_.value().second.trace());
   ++edits_;
@@ -209,13 +204,19 @@ void BrickGrid::receiveMoveIndex(Move& m) {
 // and summed twice, 29 M of a 50k-brick cut's 111 M instructions (Split_CutInTwo).
 void BrickGrid::receiveMoveBricks(Move& m) {
   BW_ASSERT(m.into_ == this);
-  // (this grid was empty: beginMove checked) Its reference is the old grid's, so the sum made
-  // here of the bricks gatherMove put in place is the part's sum about it.
+  // (this grid was empty: prepareMove checked) Its reference is the old grid's, so the sum
+  // addValidBricks makes here is the part's sum about it.
   if (!m.newIds_.empty()) {
     reference_ = m.reference_;
     referenceSet_ = true;
   }
-  addMomentsOf(m.newIds_);
+  // The bricks are in place (gatherMove wrote them): their moments, in the ids' order.
+  for (const uint32_t id : m.newIds_) {
+    const Brick& b = bricks_.get<0>(id);
+    moments_.add(brickMoments(b, config_.density[b.material], reference_));
+  }
+  peakSecond_ = std::max(peakSecond_, moments_.value().second.trace());
+  ++edits_;
   m.moments_ = moments_;
   rebaseIfCancelling();  // a small part far from the old grid's reference point
   finishMoveMassStep(m);

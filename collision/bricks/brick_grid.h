@@ -141,8 +141,8 @@ class BrickGrid {
   /// state is moveBricks'. Only an allocation failure can stop a step half way.
   /// receiveMove is itself two steps that touch separate state and may run at the same time:
   /// receiveMoveIndex (the index build, and each brick's element) and receiveMoveBricks (the
-  /// grid's mass: the gather put the bricks in their slots); releaseMove likewise is
-  /// releaseMoveIndex (the bulk removal) and releaseMoveBricks (the bricks and the mass). The moved bricks' moments are summed once,
+  /// grid's mass: the gather put the bricks in their slots); releaseMove likewise is releaseMoveIndex (the bulk removal)
+  /// and releaseMoveBricks (the bricks and the mass). The moved bricks' moments are summed once,
   /// by receiveMoveBricks, about this grid's reference point, which `into` takes as its own;
   /// whichever of receiveMoveBricks and releaseMoveBricks finishes second takes that sum out of
   /// this grid's mass (so either order, or both at once, still works: this grid's mass is
@@ -282,8 +282,6 @@ class BrickGrid {
   void indexMovedBricks(const Move& m);
   /// The bricks (column 0) and their mass.
   void addValidBricks(const std::vector<uint32_t>& ids, std::span<const Brick> bricks);
-  /// The mass of bricks already in column 0, in the ids' order (counts as an edit).
-  void addMomentsOf(const std::vector<uint32_t>& ids);
   void rebaseIfCancelling();
   /// Counts one of a move's two mass steps; the second takes the moved bricks' moments out of
   /// the grid they left (after both, so neither step waits for the other).
